@@ -93,8 +93,10 @@ def max_affine_norm(M: ArrayLike, c: ArrayLike) -> NDArray[np.float64]:
     s2 = s**2
     mu = _secular_mu(s2, s2 * d**2)
     delta = s2[:, :1] - s2 + mu[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        q = np.where(d != 0, d**2 / delta, 0.0).sum(axis=1)
+    d2 = d**2
+    # d2 > 0 implies delta > 0 here (mu > 0 whenever the top component is non-zero);
+    # the floor only guards against w = s^2 d^2 underflowing while d^2 does not.
+    q = np.where(d2 > 0, d2 / np.maximum(delta, np.finfo(float).tiny), 0.0).sum(axis=1)
     value = np.sqrt((s2[:, 0] + mu) * (1.0 + q))
     return value[0] if single else value
 
@@ -134,7 +136,9 @@ def containment_margin(a: ArrayLike, b: ArrayLike, xi: ArrayLike) -> NDArray[np.
 def linearised_margin(
     a: ArrayLike, b: ArrayLike, alpha: ArrayLike, xi: ArrayLike
 ) -> NDArray[np.float64] | float:
-    """``G(alpha, omega, tau) = max_{|u|<=1} ||diag(1/b)((alpha I + hat(omega)) diag(a) u + tau)||``.
+    """``G(alpha, omega, tau) = max_{|u|<=1} ||B^-1((alpha I + hat(omega)) A u + tau)||``.
+
+    ``A = diag(a)``, ``B = diag(b)``.
 
     ``G`` is convex and positively homogeneous of degree one in ``(alpha, omega, tau)``;
     ``G(1, omega, tau)`` is the paper's first-order margin and, in 2D,

@@ -151,7 +151,9 @@ class ConvexLowerBound:
         self.d = kc_dimension(self.n)
         self.r = rotation_dimension(self.n)
         if not 1 <= int(max_nonzero) <= self.d:
-            raise ValueError(f"max_nonzero: expected an integer in [1, {self.d}], got {max_nonzero}")
+            raise ValueError(
+                f"max_nonzero: expected an integer in [1, {self.d}], got {max_nonzero}"
+            )
         self.sound = bool(sound)
         ratio = self.a.max() / self.a.min()
         self.kappa = (ratio + 1.0 / ratio) / (2.0 * (1.0 + self.inflation)) if self.n == 3 else 0.0

@@ -1,0 +1,145 @@
+"""The ``kcplan`` command.
+
+Exit codes: 0 success, 2 bad input (one line on stderr, no traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+__all__ = ["main"]
+
+
+class InputError(Exception):
+    """Bad user input; reported as one line with exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2, no usage dump
+        raise InputError(f"{self.prog}: {message}")
+
+
+def bounds_report(semi_axes: Sequence[float], inflation: float) -> dict:
+    """Vertex count and volumes of both bounds and of the true KC set, with ratios.
+
+    Volumes are in rad^r * length^n over the identity component, exponential-coordinate
+    measure (see :mod:`kcplan.kc.volume`).
+    """
+    from kcplan.kc import ConvexLowerBound, GeometricLowerBound, kc_volume
+
+    t0 = time.perf_counter()
+    convex = ConvexLowerBound(semi_axes, inflation)
+    geometric = GeometricLowerBound(semi_axes, inflation)
+    v_convex = convex.volume()
+    v_geometric = geometric.volume()
+    v_true = kc_volume(semi_axes, inflation)
+    return {
+        "semi_axes": [float(x) for x in convex.a],
+        "inflation": convex.inflation,
+        "convex_vertices": convex.n_vertices,
+        "convex_halfspaces": int(len(convex.halfspaces[1])),
+        "convex_rotation_extent": convex.rotation_extent,
+        "volume_convex": v_convex,
+        "volume_geometric": v_geometric,
+        "volume_kc": v_true,
+        "ratio_convex": v_convex / v_true,
+        "ratio_geometric": v_geometric / v_true,
+        "seconds": time.perf_counter() - t0,
+        "_bound": convex,
+    }
+
+
+def _cmd_bounds(args: argparse.Namespace) -> int:
+    if len(args.semi_axes) not in (2, 3):
+        raise InputError(
+            f"kcplan bounds: --semi-axes: expected 2 or 3 numbers, got {len(args.semi_axes)}"
+        )
+    try:
+        report = bounds_report(args.semi_axes, args.inflation)
+    except ValueError as err:
+        raise InputError(f"kcplan bounds: {err}") from None
+    bound = report.pop("_bound")
+    if args.plot:
+        from kcplan.viz import plot_convex_bound
+
+        plot_convex_bound(bound, args.plot)
+    if args.json:
+        print(json.dumps(report, indent=2))
+        return 0
+    n = len(report["semi_axes"])
+    unit = "rad * length^2" if n == 2 else "rad^3 * length^3"
+    print(f"robot semi-axes {report['semi_axes']}, inflation {report['inflation']:g}")
+    print(
+        f"convex lower bound : {report['convex_vertices']} vertices, "
+        f"{report['convex_halfspaces']} half-spaces, rotation extent "
+        f"{report['convex_rotation_extent']:.4f} rad"
+    )
+    print(f"volume convex      : {report['volume_convex']:.6g} {unit}")
+    print(f"volume geometric   : {report['volume_geometric']:.6g} {unit}")
+    print(f"volume true KC     : {report['volume_kc']:.6g} {unit}")
+    print(f"convex / true      : {report['ratio_convex']:.4f}")
+    print(f"geometric / true   : {report['ratio_geometric']:.4f}")
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def _finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="kcplan", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p = sub.add_parser(
+        "bounds",
+        help="volumes of the convex and geometric lower bounds and of the true KC set",
+        description="Build the convex lower bound of E_a in (1 + eps) E_a and compare the "
+        "volumes of both lower bounds with the true KC volume (identity component, "
+        "exponential coordinates).",
+    )
+    p.add_argument(
+        "--semi-axes",
+        nargs="+",
+        type=_finite_float,
+        required=True,
+        metavar="A",
+        help="robot semi-axes, 2 (ellipse) or 3 (ellipsoid) numbers",
+    )
+    p.add_argument(
+        "--inflation",
+        type=_finite_float,
+        required=True,
+        metavar="EPS",
+        help="guard inflation eps > 0; the guard is (1 + eps) times the robot",
+    )
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--plot", metavar="FILE.png", help="draw the convex lower bound")
+    p.set_defaults(handler=_cmd_bounds)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``kcplan`` console script; returns the exit code."""
+    try:
+        args = build_parser().parse_args(argv)
+        return args.handler(args)
+    except InputError as err:
+        print(str(err), file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
