@@ -65,9 +65,13 @@ def table1(out: Path, samples: int, rng: np.random.Generator) -> list[list]:
         n = len(a)
         b = (1 + eps) * a
         r = 1 if n == 2 else 3
-        theta = exact_extreme_rotation(np.sort(a)[::-1][:2], eps) if n == 2 else max(
-            exact_extreme_rotation(np.array([a[i], a[j]]), eps)
-            for i, j in [(0, 1), (0, 2), (1, 2)]
+        theta = (
+            exact_extreme_rotation(np.sort(a)[::-1][:2], eps)
+            if n == 2
+            else max(
+                exact_extreme_rotation(np.array([a[i], a[j]]), eps)
+                for i, j in [(0, 1), (0, 2), (1, 2)]
+            )
         )
         box = np.r_[np.full(r, 1.2 * theta), 1.2 * eps * a]
         X = (rng.random((samples, len(box))) * 2 - 1) * box
@@ -75,20 +79,39 @@ def table1(out: Path, samples: int, rng: np.random.Generator) -> list[list]:
         first = first_order_margin(a, b, X) <= 1
         # targeted: points on the boundary of F along random directions
         D = rng.normal(size=(samples, len(box))) * box
-        t = ray_extent(lambda Y: first_order_margin(a, b, Y), D, upper=1.0)
+        t = ray_extent(lambda Y, a=a, b=b: first_order_margin(a, b, Y), D, upper=1.0)
         m_boundary = containment_margin(a, b, t[:, None] * D)
-        rows.append([
-            n, a.tolist(), eps, samples,
-            int(np.sum(exact & first)), int(np.sum(exact & ~first)),
-            int(np.sum(~exact & first)), int(np.sum(~exact & ~first)),
-            int(np.sum(m_boundary > 1 + 1e-12)), float(m_boundary.max()),
-        ])
+        rows.append(
+            [
+                n,
+                a.tolist(),
+                eps,
+                samples,
+                int(np.sum(exact & first)),
+                int(np.sum(exact & ~first)),
+                int(np.sum(~exact & first)),
+                int(np.sum(~exact & ~first)),
+                int(np.sum(m_boundary > 1 + 1e-12)),
+                float(m_boundary.max()),
+            ]
+        )
         log(f"table 1, n = {n}: {rows[-1]}")
-    write_csv(out / "table1_confusion.csv", [
-        "n", "semi_axes", "inflation", "samples",
-        "exact_in_first_in", "exact_in_first_out", "exact_out_first_in", "exact_out_first_out",
-        "boundary_points_of_F_outside_KC", "max_exact_margin_on_boundary_of_F",
-    ], rows)
+    write_csv(
+        out / "table1_confusion.csv",
+        [
+            "n",
+            "semi_axes",
+            "inflation",
+            "samples",
+            "exact_in_first_in",
+            "exact_in_first_out",
+            "exact_out_first_in",
+            "exact_out_first_out",
+            "boundary_points_of_F_outside_KC",
+            "max_exact_margin_on_boundary_of_F",
+        ],
+        rows,
+    )
     return rows
 
 
@@ -106,10 +129,24 @@ def sweep(out: Path, name: str, xlabel: str, xs, shapes, title: str) -> None:
         t0 = time.perf_counter()
         vc, vg, vk = volumes(a, eps)
         rows.append([x, a.tolist(), eps, vc, vg, vk, vc / vk, vg / vk])
-        log(f"{name}: x = {x:.4g}  convex/true {vc / vk:.4f}  geometric/true {vg / vk:.4f} "
-            f"({time.perf_counter() - t0:.1f}s)")
-    write_csv(out / f"{name}.csv", ["x", "semi_axes", "inflation", "volume_convex",
-              "volume_geometric", "volume_kc", "ratio_convex", "ratio_geometric"], rows)
+        log(
+            f"{name}: x = {x:.4g}  convex/true {vc / vk:.4f}  geometric/true {vg / vk:.4f} "
+            f"({time.perf_counter() - t0:.1f}s)"
+        )
+    write_csv(
+        out / f"{name}.csv",
+        [
+            "x",
+            "semi_axes",
+            "inflation",
+            "volume_convex",
+            "volume_geometric",
+            "volume_kc",
+            "ratio_convex",
+            "ratio_geometric",
+        ],
+        rows,
+    )
     import matplotlib.pyplot as plt
 
     R = np.array([[r[0], r[3], r[4], r[5], r[6], r[7]] for r in rows], dtype=float)
@@ -138,19 +175,37 @@ def aspect_grid(out: Path, alphas) -> None:
             a = np.array([4.0, 4.0 / a1, 4.0 / a2])
             vc, vg, vk = volumes(a, 0.1)
             rows.append([a1, a2, a.tolist(), vc, vg, vk, vc / vk, vg / vk])
-            log(f"fig 10: alpha = ({a1:.3f}, {a2:.3f})  convex/true {vc / vk:.4f}  "
-                f"geometric/true {vg / vk:.4f}")
-    write_csv(out / "fig10_volumes_3d_aspect.csv", ["alpha1", "alpha2", "semi_axes",
-              "volume_convex", "volume_geometric", "volume_kc", "ratio_convex",
-              "ratio_geometric"], rows)
+            log(
+                f"fig 10: alpha = ({a1:.3f}, {a2:.3f})  convex/true {vc / vk:.4f}  "
+                f"geometric/true {vg / vk:.4f}"
+            )
+    write_csv(
+        out / "fig10_volumes_3d_aspect.csv",
+        [
+            "alpha1",
+            "alpha2",
+            "semi_axes",
+            "volume_convex",
+            "volume_geometric",
+            "volume_kc",
+            "ratio_convex",
+            "ratio_geometric",
+        ],
+        rows,
+    )
     import matplotlib.pyplot as plt
 
     k = len(alphas)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, col, label in [(axes[0], 7, "geometric / true"), (axes[1], 6, "convex / true")]:
         Z = np.array([r[col] for r in rows]).reshape(k, k)
-        im = ax.imshow(Z.T, origin="lower", extent=[alphas[0], alphas[-1], alphas[0], alphas[-1]],
-                       aspect="auto", cmap="viridis")
+        im = ax.imshow(
+            Z.T,
+            origin="lower",
+            extent=[alphas[0], alphas[-1], alphas[0], alphas[-1]],
+            aspect="auto",
+            cmap="viridis",
+        )
         fig.colorbar(im, ax=ax)
         ax.set_xlabel("alpha1 = a1 / a2")
         ax.set_ylabel("alpha2 = a1 / a3")
@@ -167,11 +222,28 @@ def extreme_rotation_table(out: Path) -> None:
             axis = np.array([[1.0, 0, 0]])
             num_exact = ray_extent(lambda X, b=b, a=a: containment_margin(a, b, X), axis)[0]
             num_first = ray_extent(lambda X, b=b, a=a: first_order_margin(a, b, X), axis)[0]
-            rows.append([a.tolist(), eps, exact_extreme_rotation(a, eps), num_exact,
-                         first_order_extreme_rotation(a, eps), num_first])
-    write_csv(out / "eq38_extreme_rotation.csv", ["semi_axes", "inflation",
-              "closed_form_exact", "numerical_exact", "closed_form_first_order",
-              "numerical_first_order"], rows)
+            rows.append(
+                [
+                    a.tolist(),
+                    eps,
+                    exact_extreme_rotation(a, eps),
+                    num_exact,
+                    first_order_extreme_rotation(a, eps),
+                    num_first,
+                ]
+            )
+    write_csv(
+        out / "eq38_extreme_rotation.csv",
+        [
+            "semi_axes",
+            "inflation",
+            "closed_form_exact",
+            "numerical_exact",
+            "closed_form_first_order",
+            "numerical_first_order",
+        ],
+        rows,
+    )
     err_e = max(abs(r[2] - r[3]) for r in rows)
     err_f = max(abs(r[4] - r[5]) for r in rows)
     log(f"eq. 38: closed forms vs numerical: exact {err_e:.2e}, first order {err_f:.2e}")
@@ -189,14 +261,32 @@ def main(argv: list[str] | None = None) -> int:
     table1(args.out, 10_000, rng)
     extreme_rotation_table(args.out)
     eps2 = np.linspace(0.02, 0.2, k)
-    sweep(args.out, "fig7_volumes_2d_inflation", "inflation eps", eps2,
-          [(A2, e) for e in eps2], "2D, a = [5, 3.5] (paper Fig. 7)")
+    sweep(
+        args.out,
+        "fig7_volumes_2d_inflation",
+        "inflation eps",
+        eps2,
+        [(A2, e) for e in eps2],
+        "2D, a = [5, 3.5] (paper Fig. 7)",
+    )
     ratios = np.linspace(1.1, 1.5, k)
-    sweep(args.out, "fig8_volumes_2d_aspect", "aspect a1 / a2", ratios,
-          [(np.array([5.0, 5.0 / r]), 0.08) for r in ratios], "2D, a1 = 5, eps = 0.08 (Fig. 8)")
+    sweep(
+        args.out,
+        "fig8_volumes_2d_aspect",
+        "aspect a1 / a2",
+        ratios,
+        [(np.array([5.0, 5.0 / r]), 0.08) for r in ratios],
+        "2D, a1 = 5, eps = 0.08 (Fig. 8)",
+    )
     eps3 = np.linspace(0.01, 0.2, 4 if args.quick else 7)
-    sweep(args.out, "fig9_volumes_3d_inflation", "inflation eps", eps3,
-          [(A3, e) for e in eps3], "3D, a = [4, 2.5, 2] (paper Fig. 9)")
+    sweep(
+        args.out,
+        "fig9_volumes_3d_inflation",
+        "inflation eps",
+        eps3,
+        [(A3, e) for e in eps3],
+        "3D, a = [4, 2.5, 2] (paper Fig. 9)",
+    )
     aspect_grid(args.out, np.linspace(1.0, 1.2, 3 if args.quick else 4))
     return 0
 
