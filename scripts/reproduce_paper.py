@@ -28,6 +28,13 @@ from kcplan.viz import save_figure
 
 A2 = np.array([5.0, 3.5])
 A3 = np.array([4.0, 2.5, 2.0])
+VOLUME_COLUMNS = [
+    "volume_convex",
+    "volume_geometric",
+    "volume_kc",
+    "ratio_convex",
+    "ratio_geometric",
+]
 
 
 def log(msg: str) -> None:
@@ -139,11 +146,7 @@ def sweep(out: Path, name: str, xlabel: str, xs, shapes, title: str) -> None:
             "x",
             "semi_axes",
             "inflation",
-            "volume_convex",
-            "volume_geometric",
-            "volume_kc",
-            "ratio_convex",
-            "ratio_geometric",
+            *VOLUME_COLUMNS,
         ],
         rows,
     )
@@ -185,11 +188,7 @@ def aspect_grid(out: Path, alphas) -> None:
             "alpha1",
             "alpha2",
             "semi_axes",
-            "volume_convex",
-            "volume_geometric",
-            "volume_kc",
-            "ratio_convex",
-            "ratio_geometric",
+            *VOLUME_COLUMNS,
         ],
         rows,
     )
