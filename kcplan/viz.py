@@ -1,9 +1,12 @@
-"""Matplotlib figures of KC bounds. Files are written atomically (temporary file, then rename)."""
+"""Matplotlib figures: KC bounds, scenarios and paths.
+
+Files are written atomically (temporary file, then rename)."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -14,9 +17,11 @@ import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from scipy.spatial import ConvexHull  # noqa: E402
 
+from kcplan.geometry.pose import pose_frame  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
+from kcplan.world.scenario import Scenario  # noqa: E402
 
-__all__ = ["save_figure", "plot_convex_bound"]
+__all__ = ["save_figure", "plot_convex_bound", "plot_scenario", "draw_scenario"]
 
 
 def save_figure(fig: plt.Figure, path: str | os.PathLike, dpi: int = 120) -> None:
@@ -77,4 +82,123 @@ def plot_convex_bound(bound: ConvexLowerBound, path: str | os.PathLike) -> None:
             ax.set_zlabel(labels[2])
             ax.set_title(["rotation projection", "translation projection"][i])
         fig.suptitle(f"{title}: {bound.n_vertices} vertices, {len(bound.halfspaces[1])} facets")
+    save_figure(fig, path)
+
+
+_OBSTACLE_STYLE = {"facecolor": "0.55", "edgecolor": "0.25", "linewidth": 0.6}
+
+
+def _ellipse_outline(center, R, axes, k: int = 72) -> np.ndarray:
+    t = np.linspace(0.0, 2.0 * np.pi, k)
+    return center + (np.column_stack([np.cos(t), np.sin(t)]) * axes) @ R.T
+
+
+def _ellipsoid_surface(center, R, axes, k: int = 16):
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 2 * k), np.linspace(0, np.pi, k))
+    unit = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
+    pts = center + (unit * axes) @ R.T
+    return pts[..., 0], pts[..., 1], pts[..., 2]
+
+
+def _box_faces(center, R, half) -> list[np.ndarray]:
+    s = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+                  [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]])  # fmt: skip
+    V = center + (s * half) @ R.T
+    quads = [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 3, 7, 4]]
+    return [V[q] for q in quads]
+
+
+def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None) -> None:
+    """Draw a scenario's obstacles, bounds, start and goal robots on ``ax``.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes (2D) or Axes3D (3D)
+    scenario : Scenario
+    poses : sequence of pose vectors, optional
+        Extra robot poses to draw (e.g. along a path), in the flat pose layout.
+    guards : float, optional
+        Also outline the guard ``(1 + guards) a`` at start and goal.
+    """
+    n, a = scenario.dimension, scenario.semi_axes
+    low, high = scenario.bounds
+    if n == 2:
+        from matplotlib.patches import Polygon, Rectangle
+
+        ax.add_patch(Rectangle(low, *(high - low), fill=False, ls="--", ec="0.4", lw=0.8))
+        for ob in scenario.obstacles:
+            if ob.kind in ("box", "polygon"):
+                for piece in ob.pieces:
+                    ax.add_patch(Polygon(piece, closed=True, **{**_OBSTACLE_STYLE, "linewidth": 0}))
+                outline = ob.pieces[0] if ob.kind == "box" else np.asarray(
+                    [[float(x) for x in v] for v in ob.spec["vertices"]])  # fmt: skip
+                ax.add_patch(Polygon(outline, closed=True, fill=False, ec="0.25", lw=0.6))
+            else:
+                ax.add_patch(Polygon(_ellipse_outline(ob.center, ob.rotation, ob.extents),
+                                     closed=True, **_OBSTACLE_STYLE))  # fmt: skip
+        for pose in poses:
+            R, t = pose_frame(pose, 2)
+            ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
+        for pose, color, label in ((scenario.start, "tab:green", "start"),
+                                   (scenario.goal, "tab:red", "goal")):  # fmt: skip
+            R, t = pose_frame(pose, 2)
+            ax.add_patch(Polygon(_ellipse_outline(t, R, a), closed=True, fc=color, alpha=0.5,
+                                 ec=color, label=label))  # fmt: skip
+            ax.plot(*np.array([t, t + R[:, 0] * a[0]]).T, color="k", lw=0.8)
+            if guards:
+                ax.plot(*_ellipse_outline(t, R, (1 + guards) * a).T, color=color, ls=":", lw=0.8)
+        pad = 0.03 * (high - low).max()
+        ax.set_xlim(low[0] - pad, high[0] + pad)
+        ax.set_ylim(low[1] - pad, high[1] + pad)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        return
+    faces, colors = [], []
+    for ob in scenario.obstacles:
+        if ob.kind == "box":
+            faces += _box_faces(ob.center, ob.rotation, ob.extents)
+            colors += ["0.6"] * 6
+        elif ob.kind == "mesh":
+            faces += list(ob.vertices[ob.triangles])
+            colors += ["tab:brown"] * len(ob.triangles)
+        else:
+            ax.plot_surface(*_ellipsoid_surface(ob.center, ob.rotation, ob.extents),
+                            color="0.6", alpha=0.5, linewidth=0)  # fmt: skip
+    if faces:
+        ax.add_collection3d(Poly3DCollection(faces, facecolors=colors, edgecolors="0.3",
+                                             linewidths=0.2, alpha=0.35))  # fmt: skip
+    for pose in poses:
+        R, t = pose_frame(pose, 3)
+        ax.plot_wireframe(*_ellipsoid_surface(t, R, a, 8), color="tab:blue", lw=0.3, alpha=0.5)
+    for pose, color in ((scenario.start, "tab:green"), (scenario.goal, "tab:red")):
+        R, t = pose_frame(pose, 3)
+        ax.plot_surface(*_ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
+    corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
+    for i in range(8):
+        for j in range(i + 1, 8):
+            if np.count_nonzero(corners[i] != corners[j]) == 1:
+                ax.plot(*corners[[i, j]].T, color="0.5", ls="--", lw=0.5)
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
+    ax.set_zlim(low[2], high[2])
+    ax.set_box_aspect(high - low)
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+
+
+def plot_scenario(scenario: Scenario, path: str | os.PathLike, poses=(), title: str | None = None,
+                  guards: float | None = None) -> None:  # fmt: skip
+    """Draw a scenario (2D top view or 3D perspective) into an image file."""
+    if scenario.dimension == 2:
+        low, high = scenario.bounds
+        w, h = high - low
+        fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * h / w) + 0.6))
+    else:
+        fig = plt.figure(figsize=(8, 7))
+        ax = fig.add_subplot(projection="3d")
+    draw_scenario(ax, scenario, poses, guards)
+    heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
+    ax.set_title(title or "\n".join(textwrap.wrap(heading, 100)), fontsize=9)
     save_figure(fig, path)

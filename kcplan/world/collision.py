@@ -1,0 +1,206 @@
+"""The FCL collision world of a scenario: collision and clearance queries for the robot.
+
+The plane in FCL
+----------------
+In 2D the robot is the ellipsoid ``(a1, a2, h)`` with ``h = min(a)`` at height 0, and
+every obstacle is a solid whose **slice at z = 0 and projection onto the plane are both
+the planar obstacle**: a prism (convex pieces extruded over ``|z| <= max(a)``), a sphere
+for a circle, an ellipsoid ``(a1, a2, min(a))`` for an ellipse. The robot has the same
+property. Then the 3D answers are exactly the planar ones:
+
+* if the planar shapes overlap, their z = 0 slices overlap in 3D;
+* if they do not, the projections of the 3D solids (the planar shapes) are disjoint,
+  so the solids are;
+* for distances, ``|p - q| >= |p_xy - q_xy|`` for any two points and equality is reached
+  by points of the z = 0 slices, so the 3D distance equals the planar one.
+
+``tests/test_world.py`` checks this against independent planar computations.
+
+Obstacles whose orientation is not the identity are given to FCL as convex solids with
+world-frame vertices, because FCL sizes the bounding box of a rotated object from its
+bounding sphere (a rotated long box would otherwise overlap everything in the
+broad phase). Meshes (3D) are ``fcl.BVHModel`` surfaces: a robot wholly inside a closed
+mesh touches no triangle and is reported free. A continuous motion into a mesh must cross
+its surface, so certified edges are unaffected; only a start or goal placed inside a mesh
+would be missed.
+"""
+
+from __future__ import annotations
+
+import fcl
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from kcplan.geometry.pose import pose_size
+from kcplan.world.scenario import Obstacle, Scenario
+
+__all__ = ["CollisionWorld"]
+
+
+def _prism(polygon: NDArray, half_height: float) -> fcl.Convex:
+    """Convex prism over a convex CCW polygon, ``|z| <= half_height``."""
+    k = len(polygon)
+    V = np.vstack(
+        [np.column_stack([polygon, np.full(k, -half_height)]),
+         np.column_stack([polygon, np.full(k, half_height)])]
+    )  # fmt: skip
+    faces = [k, *range(k - 1, -1, -1), k, *range(k, 2 * k)]  # bottom (outward -z), top
+    for i in range(k):
+        j = (i + 1) % k
+        faces += [4, i, j, k + j, k + i]
+    return fcl.Convex(V, k + 2, np.array(faces, dtype=np.int32))
+
+
+def _box_corners(ob: Obstacle) -> NDArray:
+    signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+    return ob.center + (signs * ob.extents) @ ob.rotation.T
+
+
+def _box3(ob: Obstacle) -> fcl.Convex:
+    V = _box_corners(ob)  # index = 4 i + 2 j + k for signs (i, j, k)
+    quads = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
+    faces = np.array([x for q in quads for x in (4, *q)], dtype=np.int32)
+    return fcl.Convex(V, 6, faces)
+
+
+def _embed(R: NDArray, n: int) -> NDArray:
+    if n == 3:
+        return R
+    out = np.eye(3)
+    out[:2, :2] = R
+    return out
+
+
+class CollisionWorld:
+    """Collision and clearance queries for a scenario's robot against its obstacles.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The obstacles and the robot semi-axes.
+    semi_axes : array_like, optional
+        Query a different robot shape (e.g. a guard ``(1 + eps) a``); default the
+        scenario's robot.
+
+    Notes
+    -----
+    Poses are flat vectors, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``
+    (:mod:`kcplan.geometry.pose`). The bounds of the scenario are not obstacles: they
+    limit where the planner samples the robot's centre.
+
+    ``counters`` counts FCL queries issued through this object: ``collision_queries``
+    and ``distance_queries`` go up by exactly one per pose queried. Not thread-safe:
+    the robot's FCL object is reused between queries.
+    """
+
+    def __init__(self, scenario: Scenario, semi_axes: ArrayLike | None = None):
+        n = scenario.dimension
+        a = np.asarray(scenario.semi_axes if semi_axes is None else semi_axes, dtype=float)
+        if a.shape != (n,) or not (a > 0).all():
+            raise ValueError(f"semi_axes: expected {n} positive numbers, got {a.tolist()}")
+        self.dimension = n
+        self.semi_axes = a
+        self.scenario = scenario
+        geometry = fcl.Ellipsoid(*a) if n == 3 else fcl.Ellipsoid(a[0], a[1], float(a.min()))
+        self._robot = fcl.CollisionObject(geometry, fcl.Transform())
+        self._half_height = float(max(a.max(), 1.0))
+        self._objects: list[fcl.CollisionObject] = []
+        self.owner: list[int] = []  # obstacle index of each FCL object
+        for ob in scenario.obstacles:
+            for geom, tf in self._fcl_parts(ob):
+                self._objects.append(fcl.CollisionObject(geom, tf))
+                self.owner.append(ob.index)
+        self._manager = fcl.DynamicAABBTreeCollisionManager()
+        if self._objects:
+            self._manager.registerObjects(self._objects)
+            self._manager.setup()
+        self._pose_size = pose_size(n)
+        self.counters = {"collision_queries": 0, "distance_queries": 0}
+
+    def _fcl_parts(self, ob: Obstacle) -> list[tuple]:
+        n, identity = self.dimension, fcl.Transform()
+        center3 = np.append(ob.center, 0.0) if n == 2 else ob.center
+        if ob.kind in ("polygon", "box") and n == 2:
+            return [(_prism(p, self._half_height), identity) for p in ob.pieces]
+        if ob.kind == "box":
+            if np.allclose(ob.rotation, np.eye(3)):
+                return [(fcl.Box(*(2 * ob.extents)), fcl.Transform(center3))]
+            return [(_box3(ob), identity)]
+        if ob.kind in ("circle", "sphere"):
+            return [(fcl.Sphere(float(ob.extents[0])), fcl.Transform(center3))]
+        if ob.kind in ("ellipse", "ellipsoid"):
+            axes = ob.extents if n == 3 else [*ob.extents, float(ob.extents.min())]
+            return [(fcl.Ellipsoid(*axes), fcl.Transform(_embed(ob.rotation, n), center3))]
+        if ob.kind == "mesh":
+            model = fcl.BVHModel()
+            model.beginModel(len(ob.vertices), len(ob.triangles))
+            model.addSubModel(ob.vertices, ob.triangles)
+            model.endModel()
+            return [(model, identity)]
+        raise ValueError(f"unknown obstacle kind {ob.kind!r}")  # pragma: no cover
+
+    @property
+    def n_objects(self) -> int:
+        """Number of FCL objects (polygons contribute one per convex piece)."""
+        return len(self._objects)
+
+    def reset_counters(self) -> None:
+        """Set the query counters to zero."""
+        for key in self.counters:
+            self.counters[key] = 0
+
+    def _place(self, pose: ArrayLike) -> None:
+        p = np.asarray(pose, dtype=float)
+        if p.shape != (self._pose_size,):
+            raise ValueError(
+                f"pose: expected {self._pose_size} numbers in {self.dimension}D, got shape {p.shape}"
+            )
+        if self.dimension == 2:
+            half = 0.5 * p[2]
+            q = np.array([np.cos(half), 0.0, 0.0, np.sin(half)])
+            self._robot.setTransform(fcl.Transform(q, np.array([p[0], p[1], 0.0])))
+        else:
+            q = np.array([p[6], p[3], p[4], p[5]])  # FCL wants [w, x, y, z]
+            self._robot.setTransform(fcl.Transform(q / np.linalg.norm(q), p[:3]))
+
+    def in_collision(self, pose: ArrayLike) -> bool:
+        """Whether the robot at ``pose`` touches or overlaps an obstacle (one FCL query)."""
+        self._place(pose)
+        self.counters["collision_queries"] += 1
+        if not self._objects:
+            return False
+        data = fcl.CollisionData()
+        self._manager.collide(self._robot, data, fcl.defaultCollisionCallback)
+        return bool(data.result.is_collision)
+
+    def clearance(self, pose: ArrayLike) -> float:
+        """Distance from the robot at ``pose`` to the nearest obstacle, 0 when they touch
+        or overlap, ``inf`` without obstacles (one FCL query). In length units; FCL's GJK
+        is iterative, so callers that certify should subtract a small tolerance."""
+        self._place(pose)
+        self.counters["distance_queries"] += 1
+        if not self._objects:
+            return float("inf")
+        data = fcl.DistanceData()
+        self._manager.distance(self._robot, data, fcl.defaultDistanceCallback)
+        return max(float(data.result.min_distance), 0.0)
+
+    def in_collision_many(self, poses: ArrayLike) -> NDArray[np.bool_]:
+        """:meth:`in_collision` for each row of ``poses`` (shape ``(k, 3 or 7)``)."""
+        P = np.asarray(poses, dtype=float).reshape(-1, self._pose_size)
+        return np.array([self.in_collision(p) for p in P], dtype=bool)
+
+    def clearance_many(self, poses: ArrayLike) -> NDArray[np.float64]:
+        """:meth:`clearance` for each row of ``poses`` (shape ``(k, 3 or 7)``)."""
+        P = np.asarray(poses, dtype=float).reshape(-1, self._pose_size)
+        return np.array([self.clearance(p) for p in P], dtype=float)
+
+    def colliding_obstacles(self, pose: ArrayLike) -> list[int]:
+        """Indices of the obstacles the robot at ``pose`` touches (diagnostics; one
+        narrow-phase test per FCL object, not counted)."""
+        self._place(pose)
+        request, hits = fcl.CollisionRequest(), []
+        for obj, owner in zip(self._objects, self.owner, strict=True):
+            if owner not in hits and fcl.collide(self._robot, obj, request, fcl.CollisionResult()):
+                hits.append(owner)
+        return hits

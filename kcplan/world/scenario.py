@@ -1,0 +1,436 @@
+"""Scenario files: the YAML format, its validating loader and its writer.
+
+A scenario is one planning problem: a robot ellipse (2D) or ellipsoid (3D), a box for the
+robot's centre, a start and a goal pose, and obstacles. The format is documented in
+``scenarios/README.md``. Every error names the file, the field and what was expected::
+
+    scenarios/x.yaml: obstacles[3].box.size: expected 2 positive numbers, got [4, -1]
+
+Poses are flat vectors (see :mod:`kcplan.geometry.pose`): ``[x, y, yaw]`` in 2D and
+``[x, y, z, qx, qy, qz, qw]`` in 3D. Lengths are in the scenario's own unit; angles in
+radians.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.typing import NDArray
+
+from kcplan.geometry.pose import quaternion_matrix
+from kcplan.geometry.rotations import exp_rotation
+from kcplan.world.mesh import read_mesh
+from kcplan.world.polygon import convex_pieces
+
+__all__ = [
+    "DEFAULT_INFLATION",
+    "MAX_SCENARIO_BYTES",
+    "MAX_OBSTACLES",
+    "MAX_POLYGON_VERTICES",
+    "Obstacle",
+    "Scenario",
+    "ScenarioError",
+    "load_scenario",
+    "parse_scenario",
+    "scenario_to_dict",
+    "dump_scenario",
+]
+
+DEFAULT_INFLATION = 0.1
+"""Guard inflation used when ``robot.inflation`` is absent: guard = 1.1 x robot."""
+MAX_SCENARIO_BYTES = 16 * 2**20
+"""Largest scenario file read, in bytes (protects against inputs that exhaust memory)."""
+MAX_OBSTACLES = 100_000
+"""Largest number of obstacles in one scenario."""
+MAX_POLYGON_VERTICES = 500
+"""Largest number of vertices of one polygon (decomposition is quadratic)."""
+QUATERNION_TOLERANCE = 1e-2
+"""Quaternions with | |q| - 1 | up to this are normalised; larger deviations are errors."""
+
+OBSTACLE_KINDS = {2: ("box", "ellipse", "circle", "polygon"), 3: ("box", "ellipsoid", "sphere", "mesh")}
+
+
+class ScenarioError(ValueError):
+    """An invalid scenario; ``str(err)`` is one line ``FILE: FIELD: expected ..., got ...``."""
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacle:
+    """One obstacle, in world coordinates.
+
+    Attributes
+    ----------
+    kind : str
+        ``box``, ``ellipse``, ``circle``, ``polygon`` (2D) or ``box``, ``ellipsoid``,
+        ``sphere``, ``mesh`` (3D).
+    index : int
+        Position in the scenario's obstacle list.
+    spec : dict
+        The validated fields as written in the file (used to write the scenario back).
+    center : ndarray, shape (n,)
+        Centre (box, ellipse, ellipsoid, circle, sphere) or mesh position.
+    rotation : ndarray, shape (n, n)
+        Orientation of the obstacle frame in the world.
+    extents : ndarray, shape (n,)
+        Half side lengths (box), semi-axes (ellipse, ellipsoid), the radius repeated
+        (circle, sphere); zeros for polygons and meshes.
+    pieces : tuple of ndarray
+        Polygon: convex pieces ``(m_i, 2)`` in world coordinates; box (2D): its rectangle.
+    vertices, triangles : ndarray or None
+        Mesh: world-frame vertices ``(v, 3)`` and triangles ``(t, 3)``.
+    """
+
+    kind: str
+    index: int
+    spec: dict
+    center: NDArray[np.float64]
+    rotation: NDArray[np.float64]
+    extents: NDArray[np.float64]
+    pieces: tuple = ()
+    vertices: NDArray[np.float64] | None = None
+    triangles: NDArray[np.int32] | None = None
+
+    @property
+    def label(self) -> str:
+        """``obstacles[i] (kind)``, as used in error messages."""
+        return f"obstacles[{self.index}] ({self.kind})"
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A validated planning problem (see the module docstring for conventions)."""
+
+    name: str
+    dimension: int
+    bounds: NDArray[np.float64]  # shape (2, n): low, high for the robot centre
+    semi_axes: NDArray[np.float64]
+    inflation: float
+    start: NDArray[np.float64]
+    goal: NDArray[np.float64]
+    obstacles: tuple[Obstacle, ...]
+    description: str = ""
+    source: str = "<string>"
+    directory: Path = field(default_factory=Path.cwd)
+
+
+def _show(value: Any, limit: int = 60) -> str:
+    text = repr(value) if isinstance(value, str) else yaml.safe_dump(
+        value, default_flow_style=True, width=10**6
+    ).strip().removesuffix("...").strip()
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+class _Reader:
+    """Typed access to parsed YAML with errors that name the file and field."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, where: str, expected: str, value: Any = None, got: str | None = None):
+        got = got if got is not None else _show(value)
+        raise ScenarioError(f"{self.source}: {where}: expected {expected}, got {got}")
+
+    def mapping(self, value: Any, where: str, required: tuple, optional: tuple = ()) -> dict:
+        if not isinstance(value, dict):
+            self.fail(where, f"a mapping with keys {', '.join(required + optional)}", value)
+        for key in value:
+            if key not in required + optional:
+                allowed = ", ".join(required + optional)
+                raise ScenarioError(
+                    f"{self.source}: {where}: unknown key {key!r}; expected one of {allowed}"
+                )
+        for key in required:
+            if key not in value:
+                raise ScenarioError(f"{self.source}: {where}: missing required key {key!r}")
+        return value
+
+    def number(self, value: Any, where: str, positive: bool = False) -> float:
+        what = "a positive number" if positive else "a finite number"
+        x = self._float(value)
+        if x is None or not math.isfinite(x) or (positive and x <= 0):
+            self.fail(where, what, value)
+        return x
+
+    @staticmethod
+    def _float(value: Any) -> float | None:
+        if isinstance(value, bool):
+            return None
+        if isinstance(value, (int, float)):
+            return float(value)
+        if isinstance(value, str):  # YAML 1.1 reads "1e3" as a string
+            try:
+                return float(value)
+            except ValueError:
+                return None
+        return None
+
+    def vector(self, value: Any, where: str, n: int, positive: bool = False) -> NDArray:
+        kind = "positive numbers" if positive else "finite numbers"
+        if not isinstance(value, list) or len(value) != n:
+            self.fail(where, f"{n} {kind}", value)
+        xs = [self._float(v) for v in value]
+        if any(x is None or not math.isfinite(x) or (positive and x <= 0) for x in xs):
+            self.fail(where, f"{n} {kind}", value)
+        return np.array(xs, dtype=float)
+
+    def text(self, value: Any, where: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            self.fail(where, "a non-empty string", value)
+        return value
+
+    def quaternion(self, value: Any, where: str) -> NDArray:
+        q = self.vector(value, where, 4)
+        norm = float(np.linalg.norm(q))
+        if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+            self.fail(where, "a unit quaternion [qx, qy, qz, qw]", value, f"{_show(value)} with norm {norm:.4g}")
+        return q / norm
+
+    def rotation(self, spec: dict, where: str, n: int) -> NDArray:
+        """Rotation matrix from an optional ``yaw`` (2D) or ``quaternion`` (3D) field."""
+        if n == 2:
+            return exp_rotation([self.number(spec.get("yaw", 0.0), f"{where}.yaw")], 2)
+        q = self.quaternion(spec.get("quaternion", [0.0, 0.0, 0.0, 1.0]), f"{where}.quaternion")
+        return quaternion_matrix(q)
+
+    def pose(self, value: Any, where: str, n: int) -> NDArray:
+        angle = "yaw" if n == 2 else "quaternion"
+        spec = self.mapping(value, where, ("position",), (angle,))
+        position = self.vector(spec["position"], f"{where}.position", n)
+        if n == 2:
+            return np.append(position, self.number(spec.get("yaw", 0.0), f"{where}.yaw"))
+        q = self.quaternion(spec.get("quaternion", [0.0, 0.0, 0.0, 1.0]), f"{where}.quaternion")
+        return np.concatenate([position, q])
+
+
+def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Obstacle:
+    where = f"obstacles[{index}]"
+    kinds = OBSTACLE_KINDS[n]
+    if not isinstance(value, dict) or len(value) != 1:
+        r.fail(where, f"a mapping with one key, the obstacle type ({', '.join(kinds)})", value)
+    ((kind, spec),) = value.items()
+    if kind not in kinds:
+        other = OBSTACLE_KINDS[5 - n]
+        hint = f" ({kind!r} is a {5 - n}D obstacle)" if kind in other else ""
+        raise ScenarioError(
+            f"{r.source}: {where}: unknown obstacle type {kind!r}{hint}; "
+            f"expected one of {', '.join(kinds)} in {n}D"
+        )
+    where = f"{where}.{kind}"
+    angle = ("yaw",) if n == 2 else ("quaternion",)
+    eye, zeros = np.eye(n), np.zeros(n)
+    if kind == "box":
+        spec = r.mapping(spec, where, ("center", "size"), angle)
+        center = r.vector(spec["center"], f"{where}.center", n)
+        half = 0.5 * r.vector(spec["size"], f"{where}.size", n, positive=True)
+        R = r.rotation(spec, where, n)
+        pieces = ()
+        if n == 2:
+            corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half
+            pieces = (center + corners @ R.T,)
+        return Obstacle(kind, index, spec, center, R, half, pieces)
+    if kind in ("ellipse", "ellipsoid"):
+        spec = r.mapping(spec, where, ("center", "semi_axes"), angle)
+        center = r.vector(spec["center"], f"{where}.center", n)
+        axes = r.vector(spec["semi_axes"], f"{where}.semi_axes", n, positive=True)
+        return Obstacle(kind, index, spec, center, r.rotation(spec, where, n), axes)
+    if kind in ("circle", "sphere"):
+        spec = r.mapping(spec, where, ("center", "radius"))
+        center = r.vector(spec["center"], f"{where}.center", n)
+        radius = r.number(spec["radius"], f"{where}.radius", positive=True)
+        return Obstacle(kind, index, spec, center, eye, np.full(n, radius))
+    if kind == "polygon":
+        spec = r.mapping(spec, where, ("vertices",))
+        vertices = spec["vertices"]
+        if not isinstance(vertices, list) or not 3 <= len(vertices) <= MAX_POLYGON_VERTICES:
+            r.fail(
+                f"{where}.vertices",
+                f"a list of 3 to {MAX_POLYGON_VERTICES} points [x, y]",
+                vertices,
+                f"{len(vertices)} points" if isinstance(vertices, list) else None,
+            )
+        pts = np.array([r.vector(v, f"{where}.vertices[{i}]", 2) for i, v in enumerate(vertices)])
+        try:
+            pieces = tuple(convex_pieces(pts))
+        except ValueError as err:
+            raise ScenarioError(f"{r.source}: {where}.vertices: {err}") from None
+        return Obstacle(kind, index, spec, pts.mean(axis=0), eye, zeros, pieces)
+    # mesh
+    spec = r.mapping(spec, where, ("file",), ("scale", "position", "quaternion"))
+    name = r.text(spec["file"], f"{where}.file")
+    path = (directory / name).resolve()
+    if not path.is_file():
+        r.fail(f"{where}.file", "an existing mesh file (relative to the scenario)", name,
+               f"{name!r}, which does not exist at {path}")  # fmt: skip
+    scale = r.number(spec.get("scale", 1.0), f"{where}.scale", positive=True)
+    position = r.vector(spec.get("position", [0.0, 0.0, 0.0]), f"{where}.position", 3)
+    R = r.rotation(spec, where, 3)
+    try:
+        local, triangles = read_mesh(path)
+    except (OSError, ValueError) as err:
+        raise ScenarioError(f"{r.source}: {where}.file: {err}") from None
+    world = position + (scale * local) @ R.T
+    return Obstacle(kind, index, spec, position, R, zeros, (), world, triangles)
+
+
+def parse_scenario(
+    data: Any, source: str = "<string>", directory: Path | None = None, check: bool = True
+) -> Scenario:
+    """Validate parsed YAML and build a :class:`Scenario`.
+
+    Parameters
+    ----------
+    data : object
+        What ``yaml.safe_load`` returned.
+    source : str
+        Name used at the start of error messages (normally the file path).
+    directory : Path, optional
+        Directory that mesh paths are relative to (default: the working directory).
+    check : bool
+        Also reject a start or goal in collision (builds a :class:`CollisionWorld`).
+
+    Raises
+    ------
+    ScenarioError
+        One-line message naming the source, the field and what was expected.
+    """
+    r = _Reader(source)
+    directory = Path.cwd() if directory is None else directory
+    top = r.mapping(
+        data,
+        "top level",
+        ("name", "dimension", "bounds", "robot", "start", "goal"),
+        ("description", "obstacles"),
+    )
+    name = r.text(top["name"], "name")
+    description = top.get("description", "")
+    if not isinstance(description, str):
+        r.fail("description", "a string", description)
+    n = top["dimension"]
+    if isinstance(n, bool) or n not in (2, 3):
+        r.fail("dimension", "2 or 3", n)
+    b = r.mapping(top["bounds"], "bounds", ("low", "high"))
+    low, high = r.vector(b["low"], "bounds.low", n), r.vector(b["high"], "bounds.high", n)
+    if not (low < high).all():
+        r.fail("bounds", "low < high in every coordinate", top["bounds"])
+    robot = r.mapping(top["robot"], "robot", ("semi_axes",), ("inflation",))
+    semi_axes = r.vector(robot["semi_axes"], "robot.semi_axes", n, positive=True)
+    inflation = r.number(robot.get("inflation", DEFAULT_INFLATION), "robot.inflation", positive=True)
+    poses = {}
+    for key in ("start", "goal"):
+        pose = r.pose(top[key], key, n)
+        if not ((low <= pose[:n]) & (pose[:n] <= high)).all():
+            r.fail(f"{key}.position", f"a point inside bounds {low.tolist()}..{high.tolist()}",
+                   pose[:n].tolist())  # fmt: skip
+        poses[key] = pose
+    items = top.get("obstacles", [])
+    if items is None:
+        items = []
+    if not isinstance(items, list):
+        r.fail("obstacles", "a list of obstacles", items)
+    if len(items) > MAX_OBSTACLES:
+        r.fail("obstacles", f"at most {MAX_OBSTACLES} obstacles", None, f"{len(items)}")
+    obstacles = tuple(_obstacle(r, item, i, n, directory) for i, item in enumerate(items))
+    scenario = Scenario(
+        name, n, np.stack([low, high]), semi_axes, inflation, poses["start"], poses["goal"],
+        obstacles, description, source, directory,
+    )  # fmt: skip
+    if check:
+        from kcplan.world.collision import CollisionWorld
+
+        world = CollisionWorld(scenario)
+        for key in ("start", "goal"):
+            hits = world.colliding_obstacles(poses[key])
+            if hits:
+                labels = ", ".join(scenario.obstacles[i].label for i in hits[:3])
+                raise ScenarioError(f"{source}: {key}: the robot collides with {labels}")
+    return scenario
+
+
+def load_scenario(path: str | os.PathLike, check: bool = True) -> Scenario:
+    """Read and validate a scenario file.
+
+    Parameters
+    ----------
+    path : path-like
+        A YAML file in the format of ``scenarios/README.md``.
+    check : bool
+        Also reject a start or goal in collision (see :func:`parse_scenario`).
+
+    Raises
+    ------
+    ScenarioError
+        For every problem with the file: unreadable, too large, not YAML, YAML syntax
+        errors (with line and column), and every invalid field.
+    """
+    source = os.fspath(path)
+    p = Path(path)
+    try:
+        size = p.stat().st_size
+        if size > MAX_SCENARIO_BYTES:
+            raise ScenarioError(
+                f"{source}: expected a scenario file of at most {MAX_SCENARIO_BYTES} bytes, "
+                f"got {size} bytes"
+            )
+        raw = p.read_bytes()
+    except OSError as err:
+        raise ScenarioError(f"{source}: cannot read the file: {err.strerror or err}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ScenarioError(f"{source}: expected a UTF-8 YAML text file, got binary data") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        problem = err.problem or err.context or "invalid YAML"
+        raise ScenarioError(f"{source}: {where}YAML syntax error: {problem}") from None
+    except (yaml.YAMLError, RecursionError) as err:
+        raise ScenarioError(f"{source}: YAML syntax error: {type(err).__name__}") from None
+    return parse_scenario(data, source, p.resolve().parent, check)
+
+
+def scenario_to_dict(scenario: Scenario) -> dict:
+    """The scenario as plain data in the file format (numbers as floats)."""
+    n = scenario.dimension
+
+    def pose(p: NDArray) -> dict:
+        out = {"position": p[:n].tolist()}
+        if n == 2:
+            out["yaw"] = float(p[2])
+        else:
+            out["quaternion"] = p[3:].tolist()
+        return out
+
+    out = {"name": scenario.name}
+    if scenario.description:
+        out["description"] = scenario.description
+    out |= {
+        "dimension": n,
+        "bounds": {"low": scenario.bounds[0].tolist(), "high": scenario.bounds[1].tolist()},
+        "robot": {"semi_axes": scenario.semi_axes.tolist(), "inflation": scenario.inflation},
+        "start": pose(scenario.start),
+        "goal": pose(scenario.goal),
+        "obstacles": [{o.kind: o.spec} for o in scenario.obstacles],
+    }
+    return out
+
+
+def dump_scenario(scenario: Scenario | dict, path: str | os.PathLike) -> None:
+    """Write a scenario (or its dict) as YAML, atomically (temporary file, then rename)."""
+    data = scenario if isinstance(scenario, dict) else scenario_to_dict(scenario)
+    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
+    target = Path(path)
+    tmp = target.with_name(f".{target.name}.tmp{os.getpid()}")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, target)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
