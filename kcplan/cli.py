@@ -10,6 +10,7 @@ import json
 import sys
 import time
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -90,6 +91,46 @@ def _cmd_bounds(args: argparse.Namespace) -> int:
     return 0
 
 
+def _load(path: str, check: bool = True):
+    """Load a scenario, turning every problem with it into an :class:`InputError`."""
+    from kcplan.world import ScenarioError, load_scenario
+
+    try:
+        return load_scenario(path, check=check)
+    except ScenarioError as err:
+        raise InputError(str(err)) from None
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from kcplan.world import ScenarioError, load_scenario
+
+    failed = 0
+    for path in args.scenarios:
+        try:
+            s = load_scenario(path)
+        except ScenarioError as err:
+            failed += 1
+            print(f"INVALID {err}")
+            continue
+        print(
+            f"ok      {path}: {s.name}, {s.dimension}D, {len(s.obstacles)} obstacles, "
+            f"robot {s.semi_axes.tolist()}"
+        )
+    if failed:
+        print(f"{failed} of {len(args.scenarios)} scenario files are invalid", file=sys.stderr)
+    return 2 if failed else 0
+
+
+def _cmd_show(args: argparse.Namespace) -> int:
+    scenario = _load(args.scenario)
+    out = args.output or str(Path(args.scenario).with_suffix(".png"))
+    from kcplan.viz import plot_scenario
+
+    plot_scenario(scenario, out, guards=scenario.inflation)
+    print(f"picture written to {out}")
+    return 0
+
+
 def _finite_float(text: str) -> float:
     try:
         value = float(text)
@@ -128,6 +169,30 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--plot", metavar="FILE.png", help="draw the convex lower bound")
     p.set_defaults(handler=_cmd_bounds)
+
+    p = sub.add_parser(
+        "validate",
+        help="check scenario files",
+        description="Check scenario files: format, values, start and goal inside the bounds and "
+        "free of obstacles. One line per file; exit 0 when all are valid, 2 otherwise.",
+    )
+    p.add_argument("scenarios", nargs="+", metavar="SCENARIO", help="YAML scenario files")
+    p.set_defaults(handler=_cmd_validate)
+
+    p = sub.add_parser(
+        "show",
+        help="draw a scenario",
+        description="Draw a scenario: obstacles, bounds, start (green) and goal (red) robots "
+        "with their guards (dotted). 2D top view, 3D perspective.",
+    )
+    p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE.png",
+        help="image file (default: beside the scenario, same name, .png)",
+    )
+    p.set_defaults(handler=_cmd_show)
     return parser
 
 

@@ -101,8 +101,18 @@ def _ellipsoid_surface(center, R, axes, k: int = 16):
 
 
 def _box_faces(center, R, half) -> list[np.ndarray]:
-    s = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                  [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]])  # fmt: skip
+    s = np.array(
+        [
+            [-1, -1, -1],
+            [1, -1, -1],
+            [1, 1, -1],
+            [-1, 1, -1],
+            [-1, -1, 1],
+            [1, -1, 1],
+            [1, 1, 1],
+            [-1, 1, 1],
+        ]
+    )
     V = center + (s * half) @ R.T
     quads = [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 3, 7, 4]]
     return [V[q] for q in quads]
@@ -130,20 +140,38 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             if ob.kind in ("box", "polygon"):
                 for piece in ob.pieces:
                     ax.add_patch(Polygon(piece, closed=True, **{**_OBSTACLE_STYLE, "linewidth": 0}))
-                outline = ob.pieces[0] if ob.kind == "box" else np.asarray(
-                    [[float(x) for x in v] for v in ob.spec["vertices"]])  # fmt: skip
+                outline = (
+                    ob.pieces[0]
+                    if ob.kind == "box"
+                    else np.asarray([[float(x) for x in v] for v in ob.spec["vertices"]])
+                )
                 ax.add_patch(Polygon(outline, closed=True, fill=False, ec="0.25", lw=0.6))
             else:
-                ax.add_patch(Polygon(_ellipse_outline(ob.center, ob.rotation, ob.extents),
-                                     closed=True, **_OBSTACLE_STYLE))  # fmt: skip
+                ax.add_patch(
+                    Polygon(
+                        _ellipse_outline(ob.center, ob.rotation, ob.extents),
+                        closed=True,
+                        **_OBSTACLE_STYLE,
+                    )
+                )
         for pose in poses:
             R, t = pose_frame(pose, 2)
             ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
-        for pose, color, label in ((scenario.start, "tab:green", "start"),
-                                   (scenario.goal, "tab:red", "goal")):  # fmt: skip
+        for pose, color, label in (
+            (scenario.start, "tab:green", "start"),
+            (scenario.goal, "tab:red", "goal"),
+        ):
             R, t = pose_frame(pose, 2)
-            ax.add_patch(Polygon(_ellipse_outline(t, R, a), closed=True, fc=color, alpha=0.5,
-                                 ec=color, label=label))  # fmt: skip
+            ax.add_patch(
+                Polygon(
+                    _ellipse_outline(t, R, a),
+                    closed=True,
+                    fc=color,
+                    alpha=0.5,
+                    ec=color,
+                    label=label,
+                )
+            )
             ax.plot(*np.array([t, t + R[:, 0] * a[0]]).T, color="k", lw=0.8)
             if guards:
                 ax.plot(*_ellipse_outline(t, R, (1 + guards) * a).T, color=color, ls=":", lw=0.8)
@@ -163,11 +191,16 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             faces += list(ob.vertices[ob.triangles])
             colors += ["tab:brown"] * len(ob.triangles)
         else:
-            ax.plot_surface(*_ellipsoid_surface(ob.center, ob.rotation, ob.extents),
-                            color="0.6", alpha=0.5, linewidth=0)  # fmt: skip
+            ax.plot_surface(
+                *_ellipsoid_surface(ob.center, ob.rotation, ob.extents),
+                color="0.6",
+                alpha=0.5,
+                linewidth=0,
+            )
     if faces:
-        ax.add_collection3d(Poly3DCollection(faces, facecolors=colors, edgecolors="0.3",
-                                             linewidths=0.2, alpha=0.35))  # fmt: skip
+        ax.add_collection3d(
+            Poly3DCollection(faces, facecolors=colors, edgecolors="0.3", linewidths=0.2, alpha=0.35)
+        )
     for pose in poses:
         R, t = pose_frame(pose, 3)
         ax.plot_wireframe(*_ellipsoid_surface(t, R, a, 8), color="tab:blue", lw=0.3, alpha=0.5)
@@ -188,8 +221,13 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
     ax.set_zlabel("z")
 
 
-def plot_scenario(scenario: Scenario, path: str | os.PathLike, poses=(), title: str | None = None,
-                  guards: float | None = None) -> None:  # fmt: skip
+def plot_scenario(
+    scenario: Scenario,
+    path: str | os.PathLike,
+    poses=(),
+    title: str | None = None,
+    guards: float | None = None,
+) -> None:
     """Draw a scenario (2D top view or 3D perspective) into an image file."""
     if scenario.dimension == 2:
         low, high = scenario.bounds

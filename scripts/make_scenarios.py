@@ -38,7 +38,9 @@ def pose3(x: float, y: float, z: float, q=(0.0, 0.0, 0.0, 1.0)) -> dict:
 
 def box(lo, hi, **extra) -> dict:
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    return {"box": {"center": [r(v) for v in (lo + hi) / 2], "size": [r(v) for v in hi - lo], **extra}}
+    return {
+        "box": {"center": [r(v) for v in (lo + hi) / 2], "size": [r(v) for v in hi - lo], **extra}
+    }
 
 
 def scenario(name, description, n, low, high, start, goal, obstacles, a=None, eps=None) -> dict:
@@ -68,17 +70,33 @@ def open_field() -> dict:
         {"ellipse": {"center": [65, 15], "semi_axes": [7, 4], "yaw": -0.3}},
         {"polygon": {"vertices": [[90, 45], [102, 40], [98, 52]]}},
     ]
-    return scenario("open_field", "open field with scattered boxes, discs, ellipses and a "
-                    "triangle: long edges in free space, where one guard certifies a lot",
-                    2, [0, 0], [120, 80], pose2(8, 40), pose2(112, 40, math.pi / 2), obstacles)  # fmt: skip
+    return scenario(
+        "open_field",
+        "open field with scattered boxes, discs, ellipses and a "
+        "triangle: long edges in free space, where one guard certifies a lot",
+        2,
+        [0, 0],
+        [120, 80],
+        pose2(8, 40),
+        pose2(112, 40, math.pi / 2),
+        obstacles,
+    )
 
 
 def narrow_corridor() -> dict:
     half = 4.0  # robot half-width 3.5: 0.5 of clearance on each side at yaw 0
     obstacles = [box([30, 0], [90, 30 - half]), box([30, 30 + half], [90, 60])]
-    return scenario("narrow_corridor", "a 60-long corridor 8 wide for a robot 7 wide: every "
-                    "state in it is within 0.5 of a wall, so guards must be thin",
-                    2, [0, 0], [120, 60], pose2(10, 30), pose2(110, 30), obstacles)  # fmt: skip
+    return scenario(
+        "narrow_corridor",
+        "a 60-long corridor 8 wide for a robot 7 wide: every "
+        "state in it is within 0.5 of a wall, so guards must be thin",
+        2,
+        [0, 0],
+        [120, 60],
+        pose2(10, 30),
+        pose2(110, 30),
+        obstacles,
+    )
 
 
 def slanted_gap() -> dict:
@@ -86,9 +104,17 @@ def slanted_gap() -> dict:
     lower = [[44, 0], [56, 0], [56, 36 - w], [44, 24 - w]]
     upper = [[44, 24 + w], [56, 36 + w], [56, 60], [44, 60]]
     obstacles = [{"polygon": {"vertices": [[r(x), r(y)] for x, y in p]}} for p in (lower, upper)]
-    return scenario("slanted_gap", "a wall 12 thick crossed by a slot 8 wide at 45 degrees: "
-                    "the 10 x 7 ellipse passes only after turning by about 45 degrees",
-                    2, [0, 0], [100, 60], pose2(15, 30), pose2(85, 30), obstacles)  # fmt: skip
+    return scenario(
+        "slanted_gap",
+        "a wall 12 thick crossed by a slot 8 wide at 45 degrees: "
+        "the 10 x 7 ellipse passes only after turning by about 45 degrees",
+        2,
+        [0, 0],
+        [100, 60],
+        pose2(15, 30),
+        pose2(85, 30),
+        obstacles,
+    )
 
 
 def maze(seed: int = 7) -> dict:
@@ -102,8 +128,11 @@ def maze(seed: int = 7) -> dict:
     seen[0, 0] = True
     while stack:  # depth-first carving
         i, j = stack[-1]
-        options = [(i + di, j + dj) for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))
-                   if 0 <= i + di < cols and 0 <= j + dj < rows and not seen[i + di, j + dj]]  # fmt: skip
+        options = [
+            (i + di, j + dj)
+            for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1))
+            if 0 <= i + di < cols and 0 <= j + dj < rows and not seen[i + di, j + dj]
+        ]
         if not options:
             stack.pop()
             continue
@@ -124,7 +153,9 @@ def maze(seed: int = 7) -> dict:
                 while k + 1 < rows and right[i, k + 1]:
                     k += 1
                 x = (i + 1) * cell
-                obstacles.append(box([x - t / 2, j * cell - t / 2], [x + t / 2, (k + 1) * cell + t / 2]))
+                obstacles.append(
+                    box([x - t / 2, j * cell - t / 2], [x + t / 2, (k + 1) * cell + t / 2])
+                )
                 j = k + 1
             else:
                 j += 1
@@ -136,23 +167,57 @@ def maze(seed: int = 7) -> dict:
                 while k + 1 < cols and up[k + 1, j]:
                     k += 1
                 y = (j + 1) * cell
-                obstacles.append(box([i * cell - t / 2, y - t / 2], [(k + 1) * cell + t / 2, y + t / 2]))
+                obstacles.append(
+                    box([i * cell - t / 2, y - t / 2], [(k + 1) * cell + t / 2, y + t / 2])
+                )
                 i = k + 1
             else:
                 i += 1
-    obstacles += [box([-t, -t], [W + t, 0]), box([-t, H], [W + t, H + t]),
-                  box([-t, 0], [0, H]), box([W, 0], [W + t, H])]  # fmt: skip
-    return scenario("maze", f"a {cols} x {rows} maze of 20-wide cells (depth-first, seed {seed}): "
-                    "long detours, many walls close to every edge",
-                    2, [0, 0], [W, H], pose2(10, 10), pose2(W - 10, H - 10, math.pi / 2), obstacles)  # fmt: skip
+    obstacles += [
+        box([-t, -t], [W + t, 0]),
+        box([-t, H], [W + t, H + t]),
+        box([-t, 0], [0, H]),
+        box([W, 0], [W + t, H]),
+    ]
+    return scenario(
+        "maze",
+        f"a {cols} x {rows} maze of 20-wide cells (depth-first, seed {seed}): "
+        "long detours, many walls close to every edge",
+        2,
+        [0, 0],
+        [W, H],
+        pose2(10, 10),
+        pose2(W - 10, H - 10, math.pi / 2),
+        obstacles,
+    )
 
 
 def bug_trap() -> dict:
-    c_shape = [[35, 20], [65, 20], [65, 60], [35, 60], [35, 46], [39, 46], [39, 56], [61, 56],
-               [61, 24], [39, 24], [39, 34], [35, 34]]  # fmt: skip
-    return scenario("bug_trap", "start inside a C-shaped trap (one non-convex polygon) whose "
-                    "12-wide mouth faces away from the goal: greedy growth gets stuck",
-                    2, [0, 0], [100, 80], pose2(52, 40), pose2(85, 40), [{"polygon": {"vertices": c_shape}}])  # fmt: skip
+    c_shape = [
+        [35, 20],
+        [65, 20],
+        [65, 60],
+        [35, 60],
+        [35, 46],
+        [39, 46],
+        [39, 56],
+        [61, 56],
+        [61, 24],
+        [39, 24],
+        [39, 34],
+        [35, 34],
+    ]
+    return scenario(
+        "bug_trap",
+        "start inside a C-shaped trap (one non-convex polygon) whose "
+        "12-wide mouth faces away from the goal: greedy growth gets stuck",
+        2,
+        [0, 0],
+        [100, 80],
+        pose2(52, 40),
+        pose2(85, 40),
+        [{"polygon": {"vertices": c_shape}}],
+    )
 
 
 def random_clutter(seed: int = 2024, count: int = 45) -> dict:
@@ -165,47 +230,108 @@ def random_clutter(seed: int = 2024, count: int = 45) -> dict:
             continue
         kind = rng.integers(3)
         if kind == 0:
-            obstacles.append({"circle": {"center": [r(v) for v in c], "radius": r(rng.uniform(2, 5))}})
+            obstacles.append(
+                {"circle": {"center": [r(v) for v in c], "radius": r(rng.uniform(2, 5))}}
+            )
         elif kind == 1:
-            obstacles.append({"box": {"center": [r(v) for v in c], "size": [r(v) for v in rng.uniform(3, 10, 2)],
-                                      "yaw": r(rng.uniform(-math.pi, math.pi))}})  # fmt: skip
+            obstacles.append(
+                {
+                    "box": {
+                        "center": [r(v) for v in c],
+                        "size": [r(v) for v in rng.uniform(3, 10, 2)],
+                        "yaw": r(rng.uniform(-math.pi, math.pi)),
+                    }
+                }
+            )
         else:
             axes = np.sort(rng.uniform(1.5, 6, 2))[::-1]
-            obstacles.append({"ellipse": {"center": [r(v) for v in c], "semi_axes": [r(v) for v in axes],
-                                          "yaw": r(rng.uniform(-math.pi, math.pi))}})  # fmt: skip
-    return scenario("random_clutter", f"{count} random discs, boxes and ellipses (seed {seed}): "
-                    "many short gaps, most of them narrower than the robot",
-                    2, [0, 0], [150, 100], pose2(*start), pose2(*goal), obstacles)  # fmt: skip
+            obstacles.append(
+                {
+                    "ellipse": {
+                        "center": [r(v) for v in c],
+                        "semi_axes": [r(v) for v in axes],
+                        "yaw": r(rng.uniform(-math.pi, math.pi)),
+                    }
+                }
+            )
+    return scenario(
+        "random_clutter",
+        f"{count} random discs, boxes and ellipses (seed {seed}): "
+        "many short gaps, most of them narrower than the robot",
+        2,
+        [0, 0],
+        [150, 100],
+        pose2(*start),
+        pose2(*goal),
+        obstacles,
+    )
 
 
 def l_turn() -> dict:
     upper_left = [[0, 24], [64, 24], [64, 26], [66, 26], [66, 100], [0, 100]]
-    lower_right = [[0, 0], [100, 0], [100, 100], [74, 100], [74, 26], [76, 26], [76, 14],
-                   [64, 14], [64, 16], [0, 16]]  # fmt: skip
+    lower_right = [
+        [0, 0],
+        [100, 0],
+        [100, 100],
+        [74, 100],
+        [74, 26],
+        [76, 26],
+        [76, 14],
+        [64, 14],
+        [64, 16],
+        [0, 16],
+    ]
     obstacles = [{"polygon": {"vertices": upper_left}}, {"polygon": {"vertices": lower_right}}]
-    return scenario("l_turn", "an L-shaped corridor 8 wide with a 12 x 12 chamber at the corner: "
-                    "the 10-long ellipse must turn by 90 degrees inside the chamber",
-                    2, [0, 0], [100, 100], pose2(8, 20), pose2(70, 92, math.pi / 2), obstacles)  # fmt: skip
+    return scenario(
+        "l_turn",
+        "an L-shaped corridor 8 wide with a 12 x 12 chamber at the corner: "
+        "the 10-long ellipse must turn by 90 degrees inside the chamber",
+        2,
+        [0, 0],
+        [100, 100],
+        pose2(8, 20),
+        pose2(70, 92, math.pi / 2),
+        obstacles,
+    )
 
 
 def thin_wall() -> dict:
     obstacles = [box([99.95, 0], [100.05, 185]), box([99.95, 195], [100.05, 200])]
-    return scenario("thin_wall", "a wall 0.1 thick with one 10-wide door far from the straight "
-                    "line; a 2 x 0.8 robot in a 200 x 200 map: OMPL's default 1 % resolution "
-                    "(about 2.9 per step) can jump through the wall",
-                    2, [0, 0], [200, 200], pose2(50, 100), pose2(150, 100), obstacles,
-                    a=[1.0, 0.4], eps=0.1)  # fmt: skip
+    return scenario(
+        "thin_wall",
+        "a wall 0.1 thick with one 10-wide door far from the straight "
+        "line; a 2 x 0.8 robot in a 200 x 200 map: OMPL's default 1 % resolution "
+        "(about 2.9 per step) can jump through the wall",
+        2,
+        [0, 0],
+        [200, 200],
+        pose2(50, 100),
+        pose2(150, 100),
+        obstacles,
+        a=[1.0, 0.4],
+        eps=0.1,
+    )
 
 
 def window_wall() -> dict:
     y0, y1, z0, z1 = 17.6, 22.4, 17.1, 22.9  # window 4.8 (y) x 5.8 (z)
     obstacles = [
-        box([39, 0, 0], [41, y0, 40]), box([39, y1, 0], [41, 40, 40]),
-        box([39, y0, 0], [41, y1, z0]), box([39, y0, z1], [41, y1, 40]),
-    ]  # fmt: skip
-    return scenario("window_wall", "a wall with one 4.8 x 5.8 window: the ellipsoid (5 wide "
-                    "in y at the start) must roll by 90 degrees about x to pass",
-                    3, [0, 0, 0], [80, 40, 40], pose3(15, 20, 20), pose3(65, 20, 20), obstacles)  # fmt: skip
+        box([39, 0, 0], [41, y0, 40]),
+        box([39, y1, 0], [41, 40, 40]),
+        box([39, y0, 0], [41, y1, z0]),
+        box([39, y0, z1], [41, y1, 40]),
+    ]
+    return scenario(
+        "window_wall",
+        "a wall with one 4.8 x 5.8 window: the ellipsoid (5 wide "
+        "in y at the start) must roll by 90 degrees about x to pass",
+        3,
+        [0, 0, 0],
+        [80, 40, 40],
+        pose3(15, 20, 20),
+        pose3(65, 20, 20),
+        obstacles,
+    )
 
 
 def box_field(seed: int = 11, count: int = 40) -> dict:
@@ -219,45 +345,116 @@ def box_field(seed: int = 11, count: int = 40) -> dict:
         if min(np.linalg.norm(c - start), np.linalg.norm(c - goal)) < 15:
             continue
         q = Rotation.random(random_state=int(rng.integers(2**31))).as_quat()
-        obstacles.append({"box": {"center": [r(v) for v in c], "size": [r(v) for v in rng.uniform(4, 14, 3)],
-                                  "quaternion": [r(v) for v in q]}})  # fmt: skip
-    return scenario("box_field", f"{count} randomly rotated boxes (seed {seed}) filling the "
-                    "middle of the volume: many gaps, few straight lines of sight",
-                    3, [0, 0, 0], [100, 60, 60], pose3(*start), pose3(*goal), obstacles)  # fmt: skip
+        obstacles.append(
+            {
+                "box": {
+                    "center": [r(v) for v in c],
+                    "size": [r(v) for v in rng.uniform(4, 14, 3)],
+                    "quaternion": [r(v) for v in q],
+                }
+            }
+        )
+    return scenario(
+        "box_field",
+        f"{count} randomly rotated boxes (seed {seed}) filling the "
+        "middle of the volume: many gaps, few straight lines of sight",
+        3,
+        [0, 0, 0],
+        [100, 60, 60],
+        pose3(*start),
+        pose3(*goal),
+        obstacles,
+    )
 
 
 def narrow_tunnel() -> dict:
     y0, y1, z0, z1 = 17.1, 22.9, 17.6, 22.4  # tunnel 5.8 (y) x 4.8 (z): 0.4 of clearance
     obstacles = [
-        box([30, 0, 0], [70, y0, 40]), box([30, y1, 0], [70, 40, 40]),
-        box([30, y0, 0], [70, y1, z0]), box([30, y0, z1], [70, y1, 40]),
-    ]  # fmt: skip
-    return scenario("narrow_tunnel", "a 40-long tunnel with 0.4 of clearance around the "
-                    "ellipsoid's cross-section: every edge inside it needs thin guards",
-                    3, [0, 0, 0], [100, 40, 40], pose3(15, 20, 20), pose3(85, 20, 20), obstacles)  # fmt: skip
+        box([30, 0, 0], [70, y0, 40]),
+        box([30, y1, 0], [70, 40, 40]),
+        box([30, y0, 0], [70, y1, z0]),
+        box([30, y0, z1], [70, y1, 40]),
+    ]
+    return scenario(
+        "narrow_tunnel",
+        "a 40-long tunnel with 0.4 of clearance around the "
+        "ellipsoid's cross-section: every edge inside it needs thin guards",
+        3,
+        [0, 0, 0],
+        [100, 40, 40],
+        pose3(15, 20, 20),
+        pose3(85, 20, 20),
+        obstacles,
+    )
 
 
 def peg_in_hole() -> dict:
     y0, y1, z0, z1 = 17.1, 22.9, 17.6, 22.4  # cavity 5.8 x 4.8, 12 deep
     obstacles = [
         box([62, 10, 10], [70, 30, 30]),
-        box([50, 10, 10], [62, y0, 30]), box([50, y1, 10], [62, 30, 30]),
-        box([50, y0, 10], [62, y1, z0]), box([50, y0, z1], [62, y1, 30]),
-    ]  # fmt: skip
+        box([50, 10, 10], [62, y0, 30]),
+        box([50, y1, 10], [62, 30, 30]),
+        box([50, y0, 10], [62, y1, z0]),
+        box([50, y0, z1], [62, y1, 30]),
+    ]
     s = math.sin(math.pi / 4)
-    return scenario("peg_in_hole", "insert the ellipsoid, turned by 90 degrees at the start, "
-                    "into a blind cavity 12 deep and 0.4 larger than its cross-section "
-                    "(the paper's parts-handling picture)",
-                    3, [0, 0, 0], [80, 40, 40], pose3(15, 20, 20, (0, 0, s, s)), pose3(57, 20, 20), obstacles)  # fmt: skip
+    return scenario(
+        "peg_in_hole",
+        "insert the ellipsoid, turned by 90 degrees at the start, "
+        "into a blind cavity 12 deep and 0.4 larger than its cross-section "
+        "(the paper's parts-handling picture)",
+        3,
+        [0, 0, 0],
+        [80, 40, 40],
+        pose3(15, 20, 20, (0, 0, s, s)),
+        pose3(57, 20, 20),
+        obstacles,
+    )
 
 
 def icosahedron() -> tuple[np.ndarray, np.ndarray]:
     p = (1 + 5**0.5) / 2
-    V = np.array([[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p],
-                  [0, -1, -p], [0, 1, -p], [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]], float)  # fmt: skip
-    T = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
-                  [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
-                  [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])  # fmt: skip
+    V = np.array(
+        [
+            [-1, p, 0],
+            [1, p, 0],
+            [-1, -p, 0],
+            [1, -p, 0],
+            [0, -1, p],
+            [0, 1, p],
+            [0, -1, -p],
+            [0, 1, -p],
+            [p, 0, -1],
+            [p, 0, 1],
+            [-p, 0, -1],
+            [-p, 0, 1],
+        ],
+        float,
+    )
+    T = np.array(
+        [
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ]
+    )
     return V / np.linalg.norm(V[0]), T
 
 
@@ -265,18 +462,54 @@ def open_space() -> dict:
     obstacles = [
         {"sphere": {"center": [30, 30, 25], "radius": 8}},
         {"sphere": {"center": [70, 70, 20], "radius": 6}},
-        {"ellipsoid": {"center": [50, 50, 25], "semi_axes": [12, 5, 4], "quaternion": [0, 0, 0.3827, 0.9239]}},
+        {
+            "ellipsoid": {
+                "center": [50, 50, 25],
+                "semi_axes": [12, 5, 4],
+                "quaternion": [0, 0, 0.3827, 0.9239],
+            }
+        },
         {"ellipsoid": {"center": [75, 30, 30], "semi_axes": [6, 6, 15]}},
-        {"box": {"center": [30, 75, 25], "size": [10, 20, 30], "quaternion": [0.2, 0.1, 0.3, 0.9274]}},
-        {"mesh": {"file": "meshes/rock.stl", "scale": 7.0, "position": [50, 20, 15], "quaternion": [0, 0, 0, 1]}},
-    ]  # fmt: skip
-    return scenario("open_space", "a sparse volume with spheres, ellipsoids, a rotated box and an "
-                    "icosahedral rock mesh: long certified edges, few queries",
-                    3, [0, 0, 0], [100, 100, 50], pose3(10, 10, 25), pose3(90, 90, 25), obstacles)  # fmt: skip
+        {
+            "box": {
+                "center": [30, 75, 25],
+                "size": [10, 20, 30],
+                "quaternion": [0.2, 0.1, 0.3, 0.9274],
+            }
+        },
+        {
+            "mesh": {
+                "file": "meshes/rock.stl",
+                "scale": 7.0,
+                "position": [50, 20, 15],
+                "quaternion": [0, 0, 0, 1],
+            }
+        },
+    ]
+    return scenario(
+        "open_space",
+        "a sparse volume with spheres, ellipsoids, a rotated box and an "
+        "icosahedral rock mesh: long certified edges, few queries",
+        3,
+        [0, 0, 0],
+        [100, 100, 50],
+        pose3(10, 10, 25),
+        pose3(90, 90, 25),
+        obstacles,
+    )
 
 
 SUITE = {
-    "2d": [open_field, narrow_corridor, slanted_gap, maze, bug_trap, random_clutter, l_turn, thin_wall],
+    "2d": [
+        open_field,
+        narrow_corridor,
+        slanted_gap,
+        maze,
+        bug_trap,
+        random_clutter,
+        l_turn,
+        thin_wall,
+    ],
     "3d": [window_wall, box_field, narrow_tunnel, peg_in_hole, open_space],
 }
 

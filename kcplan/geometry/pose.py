@@ -57,12 +57,18 @@ def quaternion_matrix(q: ArrayLike) -> NDArray[np.float64]:
     x, y, z, w = Q.T
     R = np.stack(
         [
-            1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
-            2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-            2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y),
+            1 - 2 * (y * y + z * z),
+            2 * (x * y - z * w),
+            2 * (x * z + y * w),
+            2 * (x * y + z * w),
+            1 - 2 * (x * x + z * z),
+            2 * (y * z - x * w),
+            2 * (x * z - y * w),
+            2 * (y * z + x * w),
+            1 - 2 * (x * x + y * y),
         ],
         axis=1,
-    ).reshape(-1, 3, 3)  # fmt: skip
+    ).reshape(-1, 3, 3)
     return R[0] if single else R
 
 
@@ -84,7 +90,9 @@ def pose_frame(pose: ArrayLike, n: int) -> tuple[NDArray[np.float64], NDArray[np
     single = P.ndim == 1
     P = np.atleast_2d(P)
     if P.shape[1] != pose_size(n):
-        raise ValueError(f"pose: expected {pose_size(n)} numbers per pose in {n}D, got {P.shape[1]}")
+        raise ValueError(
+            f"pose: expected {pose_size(n)} numbers per pose in {n}D, got {P.shape[1]}"
+        )
     R = exp_rotation(P[:, 2:3], 2) if n == 2 else quaternion_matrix(P[:, 3:])
     R = R.reshape(-1, n, n)
     t = P[:, :n]

@@ -51,9 +51,7 @@ def read_mesh(path: str | os.PathLike) -> tuple[NDArray[np.float64], NDArray[np.
     if len(triangles) == 0:
         raise ValueError("expected a mesh with at least one triangle, got none")
     if len(triangles) > MAX_MESH_TRIANGLES:
-        raise ValueError(
-            f"expected at most {MAX_MESH_TRIANGLES} triangles, got {len(triangles)}"
-        )
+        raise ValueError(f"expected at most {MAX_MESH_TRIANGLES} triangles, got {len(triangles)}")
     if not np.isfinite(vertices).all():
         raise ValueError("expected finite vertex coordinates, got NaN or infinity")
     if triangles.min() < 0 or triangles.max() >= len(vertices):
@@ -113,8 +111,12 @@ def _parse_obj(data: bytes) -> tuple[NDArray, NDArray]:
                 idx = [i - 1 if i > 0 else len(vertices) + i for i in idx]
                 triangles += [[idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1)]
         except (ValueError, IndexError):
-            raise ValueError(f"expected a valid OBJ line, got line {number}: {line.strip()!r}") from None
-    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(triangles, np.int32).reshape(-1, 3)
+            raise ValueError(
+                f"expected a valid OBJ line, got line {number}: {line.strip()!r}"
+            ) from None
+    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(triangles, np.int32).reshape(
+        -1, 3
+    )
 
 
 def write_stl(path: str | os.PathLike, vertices: NDArray, triangles: NDArray) -> None:

@@ -38,9 +38,11 @@ def _segments_cross(p: NDArray, q: NDArray, r: NDArray, s: NDArray, tol: float) 
         return True
 
     def on_segment(a, b, c, d) -> bool:  # c on segment ab, given |cross| <= tol
-        return abs(d) <= tol and min(a[0], b[0]) - tol <= c[0] <= max(a[0], b[0]) + tol and min(
-            a[1], b[1]
-        ) - tol <= c[1] <= max(a[1], b[1]) + tol
+        return (
+            abs(d) <= tol
+            and min(a[0], b[0]) - tol <= c[0] <= max(a[0], b[0]) + tol
+            and min(a[1], b[1]) - tol <= c[1] <= max(a[1], b[1]) + tol
+        )
 
     return (
         on_segment(r, s, p, d1)
@@ -90,9 +92,7 @@ def simple_polygon(vertices: ArrayLike) -> NDArray[np.float64]:
             if j == i + 1 or (i == 0 and j == k - 1):
                 continue  # neighbouring edges share a vertex by construction
             if _segments_cross(p[i], p[(i + 1) % k], p[j], p[(j + 1) % k], tol):
-                raise ValueError(
-                    f"expected a simple polygon, got edges {i} and {j} that intersect"
-                )
+                raise ValueError(f"expected a simple polygon, got edges {i} and {j} that intersect")
     area = polygon_area(p)
     if abs(area) <= 1e-9 * scale * scale:
         raise ValueError(f"expected a polygon with non-zero area, got area {area:.3g}")
@@ -139,7 +139,9 @@ def convex_pieces(vertices: ArrayLike) -> list[NDArray[np.float64]]:
                 continue  # reflex vertex
             others = p[[r for r in remaining if r not in (i0, i1, i2)]]
             inside = (
-                (_cross(a, b, others) >= 0) & (_cross(b, c, others) >= 0) & (_cross(c, a, others) >= 0)
+                (_cross(a, b, others) >= 0)
+                & (_cross(b, c, others) >= 0)
+                & (_cross(c, a, others) >= 0)
             )
             if not inside.any():
                 triangles.append([i0, i1, i2])

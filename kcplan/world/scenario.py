@@ -50,10 +50,17 @@ MAX_OBSTACLES = 100_000
 """Largest number of obstacles in one scenario."""
 MAX_POLYGON_VERTICES = 500
 """Largest number of vertices of one polygon (decomposition is quadratic)."""
+MAX_MAGNITUDE = 1e9
+"""Largest absolute value of any number in a scenario; FCL crashes on values near 1e300."""
+MIN_POSITIVE = 1e-9
+"""Smallest size (side, semi-axis, radius, scale, inflation) accepted."""
 QUATERNION_TOLERANCE = 1e-2
 """Quaternions with | |q| - 1 | up to this are normalised; larger deviations are errors."""
 
-OBSTACLE_KINDS = {2: ("box", "ellipse", "circle", "polygon"), 3: ("box", "ellipsoid", "sphere", "mesh")}
+OBSTACLE_KINDS = {
+    2: ("box", "ellipse", "circle", "polygon"),
+    3: ("box", "ellipsoid", "sphere", "mesh"),
+}
 
 
 class ScenarioError(ValueError):
@@ -120,9 +127,37 @@ class Scenario:
 
 
 def _show(value: Any, limit: int = 60) -> str:
-    text = repr(value) if isinstance(value, str) else yaml.safe_dump(
-        value, default_flow_style=True, width=10**6
-    ).strip().removesuffix("...").strip()
+    """A short one-line rendering of a YAML value for error messages."""
+
+    def render(v: Any, depth: int = 0) -> str:
+        if depth > 3:
+            return "..."
+        if isinstance(v, bool) or v is None:
+            return str(v).lower() if v is not None else "null"
+        if isinstance(v, float):
+            return (
+                "nan"
+                if math.isnan(v)
+                else ("inf" if v > 0 else "-inf")
+                if math.isinf(v)
+                else repr(v)
+            )
+        if isinstance(v, str):
+            return repr(v)
+        if isinstance(v, list):
+            return (
+                "["
+                + ", ".join(render(x, depth + 1) for x in v[:8])
+                + (", ...]" if len(v) > 8 else "]")
+            )
+        if isinstance(v, dict):
+            items = [
+                f"{render(k, depth + 1)}: {render(x, depth + 1)}" for k, x in list(v.items())[:6]
+            ]
+            return "{" + ", ".join(items) + (", ...}" if len(v) > 6 else "}")
+        return repr(v)
+
+    text = " ".join(render(value).split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
@@ -150,12 +185,27 @@ class _Reader:
                 raise ScenarioError(f"{self.source}: {where}: missing required key {key!r}")
         return value
 
+    @staticmethod
+    def _ok(x: float | None, positive: bool) -> bool:
+        if x is None or not math.isfinite(x) or abs(x) > MAX_MAGNITUDE:
+            return False
+        return x >= MIN_POSITIVE if positive else True
+
     def number(self, value: Any, where: str, positive: bool = False) -> float:
         what = "a positive number" if positive else "a finite number"
         x = self._float(value)
-        if x is None or not math.isfinite(x) or (positive and x <= 0):
-            self.fail(where, what, value)
+        if not self._ok(x, positive):
+            self.fail(where, what + self._range_note([x], positive), value)
         return x
+
+    @staticmethod
+    def _range_note(xs: list, positive: bool) -> str:
+        """Mention the magnitude limits only when a finite number broke them."""
+        finite = [x for x in xs if x is not None and math.isfinite(x) and (x > 0 or not positive)]
+        if any(abs(x) > MAX_MAGNITUDE or (positive and x < MIN_POSITIVE) for x in finite):
+            low = f"{MIN_POSITIVE:g} to " if positive else "at most "
+            return f" (magnitude {low}{MAX_MAGNITUDE:g})"
+        return ""
 
     @staticmethod
     def _float(value: Any) -> float | None:
@@ -175,8 +225,8 @@ class _Reader:
         if not isinstance(value, list) or len(value) != n:
             self.fail(where, f"{n} {kind}", value)
         xs = [self._float(v) for v in value]
-        if any(x is None or not math.isfinite(x) or (positive and x <= 0) for x in xs):
-            self.fail(where, f"{n} {kind}", value)
+        if not all(self._ok(x, positive) for x in xs):
+            self.fail(where, f"{n} {kind}" + self._range_note(xs, positive), value)
         return np.array(xs, dtype=float)
 
     def text(self, value: Any, where: str) -> str:
@@ -188,7 +238,12 @@ class _Reader:
         q = self.vector(value, where, 4)
         norm = float(np.linalg.norm(q))
         if abs(norm - 1.0) > QUATERNION_TOLERANCE:
-            self.fail(where, "a unit quaternion [qx, qy, qz, qw]", value, f"{_show(value)} with norm {norm:.4g}")
+            self.fail(
+                where,
+                "a unit quaternion [qx, qy, qz, qw]",
+                value,
+                f"{_show(value)} with norm {norm:.4g}",
+            )
         return q / norm
 
     def rotation(self, spec: dict, where: str, n: int) -> NDArray:
@@ -265,8 +320,12 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
     name = r.text(spec["file"], f"{where}.file")
     path = (directory / name).resolve()
     if not path.is_file():
-        r.fail(f"{where}.file", "an existing mesh file (relative to the scenario)", name,
-               f"{name!r}, which does not exist at {path}")  # fmt: skip
+        r.fail(
+            f"{where}.file",
+            "an existing mesh file (relative to the scenario)",
+            name,
+            f"{name!r}, which does not exist at {path}",
+        )
     scale = r.number(spec.get("scale", 1.0), f"{where}.scale", positive=True)
     position = r.vector(spec.get("position", [0.0, 0.0, 0.0]), f"{where}.position", 3)
     R = r.rotation(spec, where, 3)
@@ -320,13 +379,18 @@ def parse_scenario(
         r.fail("bounds", "low < high in every coordinate", top["bounds"])
     robot = r.mapping(top["robot"], "robot", ("semi_axes",), ("inflation",))
     semi_axes = r.vector(robot["semi_axes"], "robot.semi_axes", n, positive=True)
-    inflation = r.number(robot.get("inflation", DEFAULT_INFLATION), "robot.inflation", positive=True)
+    inflation = r.number(
+        robot.get("inflation", DEFAULT_INFLATION), "robot.inflation", positive=True
+    )
     poses = {}
     for key in ("start", "goal"):
         pose = r.pose(top[key], key, n)
         if not ((low <= pose[:n]) & (pose[:n] <= high)).all():
-            r.fail(f"{key}.position", f"a point inside bounds {low.tolist()}..{high.tolist()}",
-                   pose[:n].tolist())  # fmt: skip
+            r.fail(
+                f"{key}.position",
+                f"a point inside bounds {low.tolist()}..{high.tolist()}",
+                pose[:n].tolist(),
+            )
         poses[key] = pose
     items = top.get("obstacles", [])
     if items is None:
@@ -337,9 +401,18 @@ def parse_scenario(
         r.fail("obstacles", f"at most {MAX_OBSTACLES} obstacles", None, f"{len(items)}")
     obstacles = tuple(_obstacle(r, item, i, n, directory) for i, item in enumerate(items))
     scenario = Scenario(
-        name, n, np.stack([low, high]), semi_axes, inflation, poses["start"], poses["goal"],
-        obstacles, description, source, directory,
-    )  # fmt: skip
+        name,
+        n,
+        np.stack([low, high]),
+        semi_axes,
+        inflation,
+        poses["start"],
+        poses["goal"],
+        obstacles,
+        description,
+        source,
+        directory,
+    )
     if check:
         from kcplan.world.collision import CollisionWorld
 
