@@ -11,9 +11,25 @@ from kcplan.kc import ConvexLowerBound, GeometricLowerBound, kc_volume
 __version__ = "0.1.0"
 
 __all__ = [
+    "CollisionWorld",
     "ConvexLowerBound",
+    "KCMotionValidator",
+    "load_scenario",
     "GeometricLowerBound",
     "containment_margin",
     "first_order_margin",
     "kc_volume",
 ]
+
+
+def __getattr__(name: str):
+    # OMPL and FCL load only when their parts are used, so the mathematics stays light.
+    if name == "KCMotionValidator":
+        from kcplan.planning.validator import KCMotionValidator
+
+        return KCMotionValidator
+    if name in ("CollisionWorld", "load_scenario"):
+        import kcplan.world
+
+        return getattr(kcplan.world, name)
+    raise AttributeError(f"module 'kcplan' has no attribute {name!r}")

@@ -16,14 +16,17 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kcplan.geometry.rotations import exp_rotation, log_rotation
+from kcplan.geometry.rotations import exp_rotation
 
 __all__ = [
     "pose_size",
     "quaternion_matrix",
     "pose_frame",
     "wrap_angle",
-    "edge_coordinates",
+    "quaternion_multiply",
+    "rotate_vector",
+    "so2_difference",
+    "Edge",
 ]
 
 
@@ -99,55 +102,101 @@ def pose_frame(pose: ArrayLike, n: int) -> tuple[NDArray[np.float64], NDArray[np
     return (R[0], t[0]) if single else (R, t)
 
 
-def edge_coordinates(
-    pose1: ArrayLike, pose2: ArrayLike, n: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """KC coordinates of an edge relative to its midpoint, and the midpoint pose.
+def quaternion_multiply(p: NDArray, q: NDArray) -> NDArray[np.float64]:
+    """Hamilton product of quaternions ``[x, y, z, w]`` (shape (4,))."""
+    px, py, pz, pw = p
+    qx, qy, qz, qw = q
+    return np.array(
+        [
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+            pw * qw - px * qx - py * qy - pz * qz,
+        ]
+    )
 
-    Under OMPL's interpolation the robot's pose along the edge, seen from the midpoint
-    pose ``q(1/2)``, has KC coordinates ``xi(s) = (s - 1/2) xi12`` with
-    ``xi12 = [w12, R_m^T (t2 - t1)]``: a segment through the origin (all rotations along
-    the edge share one axis, and the translation moves at a constant rate). So the edge is
-    inside a guard at the midpoint iff the segment from ``-xi12/2`` to ``+xi12/2`` is.
+
+def rotate_vector(q: NDArray, v: NDArray) -> NDArray[np.float64]:
+    """Rotate ``v`` (shape (3,)) by the unit quaternion ``q = [x, y, z, w]``."""
+    u, w = q[:3], q[3]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def so2_difference(yaw1: float, yaw2: float) -> float:
+    """Signed yaw change along OMPL's SO(2) interpolation from ``yaw1`` to ``yaw2``
+    (the shorter arc; at exactly pi OMPL goes the direct way, and so does this)."""
+    diff = yaw2 - yaw1
+    if abs(diff) > np.pi:
+        diff -= np.copysign(2.0 * np.pi, diff)
+    return diff
+
+
+class Edge:
+    """A straight edge between two poses under OMPL's interpolation.
+
+    ``q(s) = (R1 exp(s hat(w12)), t1 + s (t2 - t1))`` for ``s`` in [0, 1], with ``w12``
+    the shorter rotation from R1 to R2 (SO(2): :func:`so2_difference`; SO(3): slerp, which
+    flips q2 when ``q1 . q2 < 0``). Seen from the pose ``q(m)``, the robot's KC
+    coordinates along the edge are ``xi(s) = (s - m) * direction(m)`` with
+    ``direction(m) = [w12, R(m)^T (t2 - t1)]``: a straight line through the origin,
+    because all rotations along the edge share one axis. So a guard at ``q(m)`` whose
+    convex lower bound reaches ``lam+`` along ``direction(m)`` and ``lam-`` against it
+    covers the whole stretch ``s in [m - lam-, m + lam+]`` (design notes, section 4).
 
     Parameters
     ----------
-    pose1, pose2 : array_like, shape (k, 3 or 7) or (3 or 7,)
-        Edge end poses (layout in the module docstring).
+    pose1, pose2 : array_like, shape (3,) or (7,)
+        ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``.
     n : int
         2 or 3.
-
-    Returns
-    -------
-    xi12 : ndarray, shape (k, 3 or 6) or (3 or 6,)
-        ``[w12, R_m^T (t2 - t1)]``; rotation part in exponential coordinates (radians).
-    midpoint : ndarray, shape (k, 3 or 7) or (3 or 7,)
-        The pose ``q(1/2)``.
     """
-    P1, P2 = np.atleast_2d(np.asarray(pose1, float)), np.atleast_2d(np.asarray(pose2, float))
-    single = np.ndim(pose1) == 1 and np.ndim(pose2) == 1
-    R1, t1 = pose_frame(P1, n)
-    R2, t2 = pose_frame(P2, n)
-    if n == 2:
-        w12 = wrap_angle(P2[:, 2] - P1[:, 2])[:, None]
-        yaw_m = wrap_angle(P1[:, 2] + 0.5 * w12[:, 0])
-        Rm = exp_rotation(yaw_m[:, None], 2)
-        mid = np.column_stack([0.5 * (t1 + t2), yaw_m])
-    else:
-        w12 = log_rotation(np.einsum("kji,kjl->kil", R1, R2)).reshape(-1, 3)
-        Rm = R1 @ exp_rotation(0.5 * w12, 3).reshape(-1, 3, 3)
-        mid = np.column_stack([0.5 * (t1 + t2), _matrix_quaternion(Rm, P1[:, 3:])])
-    tau = np.einsum("kji,kj->ki", Rm, t2 - t1)
-    xi12 = np.column_stack([w12, tau])
-    return (xi12[0], mid[0]) if single else (xi12, mid)
 
+    __slots__ = ("n", "t1", "dt", "yaw1", "w", "q1", "axis", "angle")
 
-def _matrix_quaternion(R: NDArray, hemisphere: NDArray) -> NDArray:
-    """Quaternions ``[qx, qy, qz, qw]`` of rotation matrices, sign chosen to agree with
-    ``hemisphere`` (so the midpoint of a slerp stays on the same side as its start)."""
-    from scipy.spatial.transform import Rotation
+    def __init__(self, pose1: ArrayLike, pose2: ArrayLike, n: int):
+        p1, p2 = np.asarray(pose1, dtype=float), np.asarray(pose2, dtype=float)
+        self.n = n
+        self.t1, self.dt = p1[:n], p2[:n] - p1[:n]
+        if n == 2:
+            self.yaw1 = float(p1[2])
+            self.w = np.array([so2_difference(p1[2], p2[2])])
+            return
+        q1 = p1[3:] / np.linalg.norm(p1[3:])
+        q2 = p2[3:] / np.linalg.norm(p2[3:])
+        if np.dot(q1, q2) < 0.0:
+            q2 = -q2
+        rel = quaternion_multiply(q1 * np.array([-1.0, -1.0, -1.0, 1.0]), q2)
+        norm = float(np.linalg.norm(rel[:3]))
+        self.q1 = q1
+        self.angle = 2.0 * np.arctan2(norm, rel[3])
+        self.axis = rel[:3] / norm if norm > 0.0 else np.array([1.0, 0.0, 0.0])
+        self.w = self.axis * self.angle
 
-    q = Rotation.from_matrix(R).as_quat()
-    flip = np.einsum("ki,ki->k", q, hemisphere) < 0
-    q[flip] *= -1.0
-    return q
+    def sweep_speed(self, radius: float) -> float:
+        """Bound on how fast any point within ``radius`` of the robot's centre moves, per
+        unit ``s``: ``|t2 - t1| + radius * |w12|`` (a rotation by angle ``phi`` moves such
+        a point by a chord at most ``radius * phi``)."""
+        return float(np.linalg.norm(self.dt) + radius * np.linalg.norm(self.w))
+
+    def pose(self, s: float) -> NDArray[np.float64]:
+        """The pose ``q(s)``."""
+        t = self.t1 + s * self.dt
+        if self.n == 2:
+            return np.array([t[0], t[1], float(wrap_angle(self.yaw1 + s * self.w[0]))])
+        return np.concatenate([t, self._rotation(s)])
+
+    def _rotation(self, s: float) -> NDArray:
+        half = 0.5 * s * self.angle
+        return quaternion_multiply(self.q1, np.append(np.sin(half) * self.axis, np.cos(half)))
+
+    def direction(self, s: float) -> NDArray[np.float64]:
+        """KC coordinates per unit ``s`` seen from ``q(s)``: ``[w12, R(s)^T (t2 - t1)]``."""
+        if self.n == 2:
+            yaw = self.yaw1 + s * self.w[0]
+            c, si = np.cos(yaw), np.sin(yaw)
+            dx, dy = self.dt
+            return np.array([self.w[0], c * dx + si * dy, -si * dx + c * dy])
+        q = self._rotation(s)
+        conj = q * np.array([-1.0, -1.0, -1.0, 1.0])
+        return np.concatenate([self.w, rotate_vector(conj, self.dt)])

@@ -1,0 +1,189 @@
+"""Planning a scenario with stock OMPL planners, with or without the KC validator.
+
+Every planner runs through :func:`plan`, the same setup code: the same state space and
+bounds, the same FCL state validity checker, the same start and goal. The only
+differences are the planner and, for the ``kc-*`` planners, the motion validator.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from kcplan.planning.states import set_state, state_pose, state_space
+from kcplan.planning.validator import KCMotionValidator
+from kcplan.world.collision import CollisionWorld
+from kcplan.world.scenario import Scenario
+
+__all__ = ["PLANNERS", "PlannerSpec", "PlanResult", "plan", "seed_ompl"]
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """A registered planner: OMPL class, whether it uses the KC validator, and why."""
+
+    make: type
+    kc: bool
+    fallback: str = "bisection"
+    description: str = ""
+
+
+PLANNERS: dict[str, PlannerSpec] = {
+    "kc-rrtconnect": PlannerSpec(
+        og.RRTConnect, True, description="stock RRT-Connect, edges certified by KC guards "
+        "(exact fallback); OMPL's default range (0.2 x the space's maximum extent)"
+    ),
+    "kc-prm": PlannerSpec(
+        og.PRM, True, description="stock PRM, roadmap edges certified by KC guards (exact "
+        "fallback)"
+    ),
+    "kc-rrtconnect-discrete": PlannerSpec(
+        og.RRTConnect, True, "discrete", "RRT-Connect with one midpoint guard, then OMPL-"
+        "style sampling (the design card's plain variant; not exact)"
+    ),
+    "rrtconnect": PlannerSpec(og.RRTConnect, False, description="stock RRT-Connect"),
+    "prm": PlannerSpec(og.PRM, False, description="stock PRM"),
+    "rrt": PlannerSpec(og.RRT, False, description="stock RRT"),
+    "rrtstar": PlannerSpec(og.RRTstar, False, description="stock RRT* (runs to the time limit)"),
+    "bitstar": PlannerSpec(og.BITstar, False, description="stock BIT* (runs to the time limit)"),
+}  # fmt: skip
+"""Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
+default discrete motion validator at the default resolution (1 % of the space extent)."""
+
+_SEEDED: list[int] = []
+ou.setLogLevel(ou.LOG_WARN)
+
+
+def seed_ompl(seed: int) -> bool:
+    """Seed OMPL's RNG, once per process (OMPL ignores later seeds for determinism).
+
+    Returns True when this call set the seed."""
+    if _SEEDED:
+        return _SEEDED[0] == seed
+    ou.RNG.setSeed(int(seed))
+    _SEEDED.append(int(seed))
+    return True
+
+
+@dataclass
+class PlanResult:
+    """What one planning run produced, as plain Python numbers (no OMPL objects)."""
+
+    scenario: str
+    planner: str
+    dimension: int
+    solved: bool
+    time: float  # seconds spent in solve()
+    simplify_time: float
+    states: list = field(default_factory=list)  # flat poses of the (simplified) path
+    length: float = 0.0  # OMPL path length (SE2: translation + 0.5 * |yaw change| ...)
+    seed: int | None = None
+    counters: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        """The ``PATH.json`` document of ``kcplan plan``."""
+        return {
+            "scenario": self.scenario,
+            "planner": self.planner,
+            "solved": self.solved,
+            "dimension": self.dimension,
+            "states": self.states,
+            "length": self.length,
+            "time": self.time,
+            "simplify_time": self.simplify_time,
+            "seed": self.seed,
+            "counters": self.counters,
+        }
+
+
+def plan(
+    scenario: Scenario,
+    planner: str = "kc-rrtconnect",
+    time_limit: float = 10.0,
+    seed: int | None = None,
+    simplify: bool = True,
+    world: CollisionWorld | None = None,
+) -> PlanResult:
+    """Plan a path for the scenario's robot from start to goal.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    planner : str
+        A key of :data:`PLANNERS`.
+    time_limit : float
+        Seconds for ``solve()``; simplification has its own budget of the same length.
+    seed : int, optional
+        Seeds OMPL's RNG (first call per process only, see :func:`seed_ompl`).
+    simplify : bool
+        Shortcut and smooth the path with OMPL's simplifier; every new edge it makes is
+        checked by the same motion validator, so kc planners keep their guarantee.
+    world : CollisionWorld, optional
+        Reuse a collision world (its counters are reset).
+
+    Returns
+    -------
+    PlanResult
+        ``counters`` holds FCL ``collision_queries`` and ``distance_queries`` (state
+        checks and guards together), ``checker_calls``, and for kc planners the
+        validator's counters.
+    """
+    if planner not in PLANNERS:
+        raise ValueError(f"planner: expected one of {', '.join(PLANNERS)}, got {planner!r}")
+    spec = PLANNERS[planner]
+    if seed is not None:
+        seed_ompl(seed)
+    n = scenario.dimension
+    world = world or CollisionWorld(scenario)
+    world.reset_counters()
+    space = state_space(*scenario.bounds)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    checker_calls = [0]
+
+    def is_valid(state) -> bool:
+        checker_calls[0] += 1
+        return not world.in_collision(state_pose(state, n))
+
+    si.setStateValidityChecker(is_valid)
+    validator = None
+    if spec.kc:
+        validator = KCMotionValidator(si, scenario.semi_axes, world, spec.fallback)
+        si.setMotionValidator(validator)
+    start, goal = si.allocState(), si.allocState()
+    set_state(start, scenario.start, n)
+    set_state(goal, scenario.goal, n)
+    ss.setStartAndGoalStates(start, goal)
+    ss.setPlanner(spec.make(si))
+    ss.setup()
+    try:
+        ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
+        solve_time = float(ss.getLastPlanComputationTime())
+        solved = bool(ss.haveExactSolutionPath())
+        simplify_time, states, length = 0.0, [], 0.0
+        if solved:
+            if simplify:
+                t0 = time.perf_counter()
+                ss.simplifySolution(float(time_limit))
+                simplify_time = time.perf_counter() - t0
+            path = ss.getSolutionPath()
+            states = [state_pose(s, n).tolist() for s in path.getStates()]
+            length = float(path.length())
+            del path
+        counters = {
+            **world.counters,
+            "fcl_queries": world.counters["collision_queries"] + world.counters["distance_queries"],
+            "checker_calls": checker_calls[0],
+        }
+        if validator is not None:
+            counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
+    finally:
+        if validator is not None:
+            validator.close()
+    return PlanResult(
+        scenario.name, planner, n, solved, solve_time, simplify_time, states, length, seed, counters
+    )

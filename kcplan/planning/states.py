@@ -1,0 +1,48 @@
+"""Conversions between OMPL SE(2)/SE(3) states and kcplan's flat pose vectors.
+
+Only getters and setters are used: ``copyFromReals`` segfaults and ``copyToReals``
+silently does nothing on the OMPL 2.0 wheel (ompl-python-notes 1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+from ompl import base as ob
+
+__all__ = ["state_space", "state_pose", "set_state"]
+
+
+def state_space(low: ArrayLike, high: ArrayLike) -> ob.StateSpace:
+    """``SE2StateSpace`` or ``SE3StateSpace`` with translation bounds ``low``..``high``."""
+    low, high = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
+    n = len(low)
+    space = ob.SE2StateSpace() if n == 2 else ob.SE3StateSpace()
+    bounds = ob.RealVectorBounds(n)
+    for i in range(n):
+        bounds.setLow(i, float(low[i]))
+        bounds.setHigh(i, float(high[i]))
+    space.setBounds(bounds)
+    return space
+
+
+def state_pose(state, n: int) -> np.ndarray:
+    """Flat pose of an OMPL state: ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``."""
+    if n == 2:
+        return np.array([state.getX(), state.getY(), state.getYaw()])
+    r = state.rotation()
+    return np.array([state.getX(), state.getY(), state.getZ(), r.x, r.y, r.z, r.w])
+
+
+def set_state(state, pose: ArrayLike, n: int) -> None:
+    """Write a flat pose into an OMPL state (quaternions are normalised)."""
+    p = np.asarray(pose, dtype=float)
+    if n == 2:
+        state.setX(float(p[0]))
+        state.setY(float(p[1]))
+        state.setYaw(float(p[2]))
+        return
+    state.setXYZ(float(p[0]), float(p[1]), float(p[2]))
+    q = p[3:] / np.linalg.norm(p[3:])
+    r = state.rotation()
+    r.x, r.y, r.z, r.w = (float(v) for v in q)

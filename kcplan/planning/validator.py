@@ -1,0 +1,92 @@
+"""The KC motion validator: an ``ompl.base.MotionValidator`` that certifies edges.
+
+Usable in any OMPL setup on SE(2) or SE(3)::
+
+    from kcplan import KCMotionValidator
+    mv = KCMotionValidator(si, semi_axes, world)
+    si.setMotionValidator(mv)
+    ...
+    mv.close()          # when done: breaks the si <-> validator reference cycle
+
+Contract (OMPL's, as far as the Python binding allows):
+
+* ``checkMotion(s1, s2)`` returns True only when the whole edge, interpolated as OMPL
+  does (linear translation, shorter-arc yaw, slerp), is proven free. ``s1`` is assumed
+  valid; ``s2`` is checked.
+* The OMPL 2.0 wheel dispatches only the two-argument ``checkMotion`` to Python. The
+  three-argument form (with ``lastValid``) calls it and leaves ``lastValid`` untouched,
+  so planners that use it (the KPIECE family) treat a rejected edge as wholly invalid;
+  none of kcplan's registered planners uses that form.
+* OMPL's own motion counters stay at zero for a Python validator; :attr:`counters` has
+  kcplan's (see :class:`kcplan.planning.certificate.EdgeCertifier`).
+* Not thread-safe; OMPL calls it from the thread that runs ``solve()``.
+"""
+
+from __future__ import annotations
+
+from numpy.typing import ArrayLike
+from ompl import base as ob
+
+from kcplan.planning.certificate import EdgeCertifier, GuardLadder
+from kcplan.planning.states import state_pose
+
+__all__ = ["KCMotionValidator"]
+
+
+class KCMotionValidator(ob.MotionValidator):
+    """Certify OMPL edges with KC guards (see the module docstring for the contract).
+
+    Parameters
+    ----------
+    si : ompl.base.SpaceInformation
+        On an ``SE2StateSpace`` or ``SE3StateSpace``.
+    semi_axes : array_like, shape (2,) or (3,)
+        The robot's semi-axes, in the state space's length unit.
+    world : object
+        ``in_collision(pose) -> bool`` and ``safe_clearance(pose) -> float`` for flat
+        poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``, e.g.
+        :class:`kcplan.world.CollisionWorld`.
+    fallback : {"bisection", "discrete"}
+        What to do with an edge the midpoint guard does not cover: more guards (exact,
+        the default) or OMPL-style sampling at the space's validity-checking resolution.
+    inflations : sequence of float, optional
+        Guard inflation ladder (default :data:`kcplan.planning.certificate.DEFAULT_LADDER`).
+    max_guards : int
+        Guards per edge before giving up ("not proven" rejects the edge).
+    """
+
+    def __init__(
+        self,
+        si: ob.SpaceInformation,
+        semi_axes: ArrayLike,
+        world,
+        fallback: str = "bisection",
+        inflations=None,
+        max_guards: int = 256,
+    ):
+        super().__init__(si)
+        self.si = si
+        self.space = si.getStateSpace()
+        ladder = GuardLadder(semi_axes, inflations)
+        self.certifier = EdgeCertifier(world, semi_axes, ladder, fallback, max_guards)
+        self.n = self.certifier.n
+
+    @property
+    def counters(self) -> dict:
+        """kcplan's counters: edges, certified_one_guard, guards, bisection_nodes,
+        collision_queries, rejected, rejected_end_state, not_proven."""
+        return self.certifier.counters
+
+    def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
+        resolution = 0.01
+        if self.certifier.fallback == "discrete":
+            length = self.space.distance(s1, s2)
+            step = self.si.getStateValidityCheckingResolution() * self.space.getMaximumExtent()
+            resolution = min(1.0, step / length) if length > 0 else 1.0
+        return bool(
+            self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
+        )
+
+    def close(self) -> None:
+        """Drop references to OMPL objects (call when done; see ompl-python-notes 6)."""
+        self.__dict__.clear()

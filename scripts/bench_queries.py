@@ -1,0 +1,57 @@
+"""Cost of one FCL collision query and one clearance query per scenario.
+
+Times ``CollisionWorld.in_collision`` and ``CollisionWorld.clearance`` at random poses
+inside each scenario's bounds (fixed seed), in repeated blocks, and prints the median
+time per query over blocks, in microseconds::
+
+    python scripts/bench_queries.py scenarios/*/*.yaml [--poses 2000] [--blocks 7]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from kcplan.world import CollisionWorld, load_scenario
+
+
+def random_poses(scenario, k: int, rng: np.random.Generator) -> np.ndarray:
+    low, high = scenario.bounds
+    t = rng.uniform(low, high, (k, scenario.dimension))
+    if scenario.dimension == 2:
+        return np.column_stack([t, rng.uniform(-np.pi, np.pi, k)])
+    q = rng.normal(size=(k, 4))
+    return np.column_stack([t, q / np.linalg.norm(q, axis=1, keepdims=True)])
+
+
+def per_query_us(fn, poses: np.ndarray, blocks: int) -> float:
+    times = []
+    for _ in range(blocks):
+        t0 = time.perf_counter()
+        for p in poses:
+            fn(p)
+        times.append((time.perf_counter() - t0) / len(poses) * 1e6)
+    return float(np.median(times))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", nargs="+")
+    parser.add_argument("--poses", type=int, default=2000)
+    parser.add_argument("--blocks", type=int, default=7)
+    args = parser.parse_args()
+    rng = np.random.default_rng(0)
+    print(f"{'scenario':<18} {'fcl objects':>11} {'collision us':>13} {'clearance us':>13} {'ratio':>6}")
+    for path in args.scenarios:
+        scenario = load_scenario(path)
+        world = CollisionWorld(scenario)
+        poses = random_poses(scenario, args.poses, rng)
+        c = per_query_us(world.in_collision, poses, args.blocks)
+        d = per_query_us(world.clearance, poses, args.blocks)
+        print(f"{scenario.name:<18} {world.n_objects:>11} {c:>13.1f} {d:>13.1f} {d / c:>6.2f}")
+
+
+if __name__ == "__main__":
+    main()
