@@ -131,6 +131,118 @@ def _cmd_show(args: argparse.Namespace) -> int:
     return 0
 
 
+def _print_counters(counters: dict) -> None:
+    keys = ["fcl_queries", "collision_queries", "distance_queries", "checker_calls"]
+    print("fcl queries     : " + ", ".join(f"{k} {counters[k]}" for k in keys if k in counters))
+    kc = {k[3:]: v for k, v in counters.items() if k.startswith("kc_")}
+    if kc:
+        print("kc validator    : " + ", ".join(f"{k} {v}" for k, v in kc.items()))
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    scenario = _load(args.scenario)
+    from kcplan.planning.problem import plan
+
+    result = plan(scenario, args.planner, args.time, args.seed, args.simplify)
+    status = "solved" if result.solved else "NOT solved"
+    print(
+        f"{scenario.name}: {status} by {args.planner} in {result.time:.3f} s "
+        f"(simplification {result.simplify_time:.3f} s)"
+    )
+    if result.solved:
+        print(f"path            : {len(result.states)} states, length {result.length:.4g}")
+    _print_counters(result.counters)
+    if args.output:
+        from kcplan.files import write_text_atomic
+
+        write_text_atomic(args.output, json.dumps(result.to_json(), indent=1) + "\n")
+        print(f"path written to {args.output}")
+    if args.plot:
+        from kcplan.viz import plot_path
+
+        guards = None
+        if args.guards and result.solved:
+            guards = path_guards(scenario, result.states)
+        plot_path(
+            scenario,
+            result.states,
+            args.plot,
+            guards=guards,
+            title=f"{scenario.name}: {args.planner}, {status}",
+        )
+        print(f"plot written to {args.plot}")
+    return 0 if result.solved else 1
+
+
+def path_guards(scenario, states) -> list:
+    """The guards (pose, inflation) that certify each edge of a path, for plotting."""
+    from kcplan.planning.certificate import EdgeCertifier
+    from kcplan.world import CollisionWorld
+
+    certifier = EdgeCertifier(CollisionWorld(scenario))
+    certifier.guard_log = []
+    for p, q in zip(states[:-1], states[1:], strict=True):
+        certifier.check(p, q)
+    return certifier.guard_log
+
+
+def _read_path(path: str, scenario) -> np.ndarray:
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the file: {err.strerror or err}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise InputError(f"{path}: expected a JSON path file, got invalid JSON ({err})") from None
+    if not isinstance(data, dict) or "states" not in data:
+        raise InputError(f"{path}: states: expected a JSON object with a 'states' list")
+    width = 3 if scenario.dimension == 2 else 7
+    try:
+        states = np.array(data["states"], dtype=float)
+    except (TypeError, ValueError):
+        states = np.zeros((0, 0))
+    if states.ndim != 2 or states.shape[1] != width or len(states) < 1:
+        raise InputError(
+            f"{path}: states: expected a non-empty list of poses with {width} numbers each "
+            f"(scenario {scenario.source} is {scenario.dimension}D)"
+        )
+    if not np.isfinite(states).all():
+        raise InputError(f"{path}: states: expected finite numbers")
+    if data.get("dimension", scenario.dimension) != scenario.dimension:
+        raise InputError(
+            f"{path}: dimension: expected {scenario.dimension}, got {data['dimension']}"
+        )
+    return states
+
+
+def _cmd_verify(args: argparse.Namespace) -> int:
+    scenario = _load(args.scenario)
+    states = _read_path(args.path, scenario)
+    from kcplan.planning.verify import verify_path
+    from kcplan.world import CollisionWorld
+
+    check = verify_path(CollisionWorld(scenario), states, tolerance=args.tolerance)
+    edges = max(len(states) - 1, 1)
+    if check.collides:
+        pose = ", ".join(f"{v:.6g}" for v in check.first_collision)
+        print(
+            f"COLLISION on edge {check.edge_index} at s = {check.s:.6f}: pose [{pose}] "
+            f"({check.queries} clearance queries)"
+        )
+        return 1
+    print(
+        f"clean: {edges} edges checked without gaps, minimum clearance "
+        f"{check.min_clearance:.6g}, {check.queries} clearance queries"
+    )
+    return 0
+
+
+def _positive_float(text: str) -> float:
+    value = _finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
 def _finite_float(text: str) -> float:
     try:
         value = float(text)
@@ -193,6 +305,56 @@ def build_parser() -> argparse.ArgumentParser:
         help="image file (default: beside the scenario, same name, .png)",
     )
     p.set_defaults(handler=_cmd_show)
+
+    from kcplan.planning.names import PLANNER_NAMES
+
+    p = sub.add_parser(
+        "plan",
+        help="plan a path with a stock OMPL planner, with or without KC certificates",
+        description="Plan from start to goal. Exit 0 solved, 1 not solved in time, 2 bad input.",
+    )
+    p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
+    p.add_argument(
+        "--planner",
+        default="kc-rrtconnect",
+        choices=PLANNER_NAMES,
+        help="planner (default kc-rrtconnect)",
+    )
+    p.add_argument(
+        "--time",
+        type=_positive_float,
+        default=10.0,
+        metavar="SECONDS",
+        help="planning time limit (default 10)",
+    )
+    p.add_argument("--seed", type=int, help="OMPL random seed, for reproducible runs")
+    p.add_argument(
+        "--simplify",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="simplify the path (every new edge is validated again; default on)",
+    )
+    p.add_argument("-o", "--output", metavar="PATH.json", help="write the path as JSON")
+    p.add_argument("--plot", metavar="FILE.png", help="draw the map and the path")
+    p.add_argument("--guards", action="store_true", help="also draw the guards certifying the path")
+    p.set_defaults(handler=_cmd_plan)
+
+    p = sub.add_parser(
+        "verify",
+        help="check a path for collisions without gaps (conservative advancement)",
+        description="Check every edge of a path, interpolated as OMPL does, with FCL "
+        "clearances and conservative advancement (independent of the KC bounds). Exit 0 "
+        "clean, 1 collision, 2 bad input.",
+    )
+    p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
+    p.add_argument("path", metavar="PATH.json", help="path file written by kcplan plan")
+    p.add_argument(
+        "--tolerance",
+        type=_positive_float,
+        default=1e-6,
+        help="clearance below which a pose counts as colliding (default 1e-6)",
+    )
+    p.set_defaults(handler=_cmd_verify)
     return parser
 
 

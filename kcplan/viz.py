@@ -17,11 +17,18 @@ import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from scipy.spatial import ConvexHull  # noqa: E402
 
-from kcplan.geometry.pose import pose_frame  # noqa: E402
+from kcplan.geometry.pose import Edge, pose_frame  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
 from kcplan.world.scenario import Scenario  # noqa: E402
 
-__all__ = ["save_figure", "plot_convex_bound", "plot_scenario", "draw_scenario"]
+__all__ = [
+    "save_figure",
+    "plot_convex_bound",
+    "plot_scenario",
+    "draw_scenario",
+    "path_poses",
+    "plot_path",
+]
 
 
 def save_figure(fig: plt.Figure, path: str | os.PathLike, dpi: int = 120) -> None:
@@ -239,4 +246,59 @@ def plot_scenario(
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
     ax.set_title(title or "\n".join(textwrap.wrap(heading, 100)), fontsize=9)
+    save_figure(fig, path)
+
+
+def path_poses(states, n: int, count: int = 40) -> np.ndarray:
+    """About ``count`` poses spread along a path by arc length of the translation, with
+    OMPL's interpolation between waypoints (waypoints included)."""
+    P = np.asarray(states, dtype=float)
+    if len(P) < 2:
+        return P
+    lengths = np.linalg.norm(np.diff(P[:, :n], axis=0), axis=1)
+    total = max(lengths.sum(), 1e-12)
+    out = [P[0]]
+    for k, length in enumerate(lengths):
+        edge = Edge(P[k], P[k + 1], n)
+        steps = max(1, int(np.ceil(count * length / total)))
+        out += [edge.pose(i / steps) for i in range(1, steps + 1)]
+    return np.array(out)
+
+
+def plot_path(
+    scenario: Scenario, states, path: str | os.PathLike, guards=None, title: str | None = None
+) -> None:
+    """Draw a scenario with a path: its centre line, the robot at intervals along it and,
+    if given, guards as ``(pose, inflation)`` pairs (dashed)."""
+    n = scenario.dimension
+    poses = path_poses(states, n) if len(states) else []
+    if n == 2:
+        low, high = scenario.bounds
+        w, h = high - low
+        fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * h / w) + 0.6))
+    else:
+        fig = plt.figure(figsize=(8, 7))
+        ax = fig.add_subplot(projection="3d")
+    draw_scenario(ax, scenario, poses)
+    if len(states):
+        P = np.asarray(states)
+        ax.plot(*P[:, :n].T, color="tab:blue", lw=1.2, marker="o", ms=3)
+    for pose, eps in guards or []:
+        R, t = pose_frame(pose, n)
+        if n == 2:
+            ax.plot(
+                *_ellipse_outline(t, R, (1 + eps) * scenario.semi_axes).T,
+                color="tab:orange",
+                ls="--",
+                lw=0.6,
+            )
+        else:
+            ax.plot_wireframe(
+                *_ellipsoid_surface(t, R, (1 + eps) * scenario.semi_axes, 6),
+                color="tab:orange",
+                lw=0.3,
+                alpha=0.5,
+            )
+    extra = f", {len(guards)} guards (dashed)" if guards else ""
+    ax.set_title((title or scenario.name) + extra, fontsize=9)
     save_figure(fig, path)

@@ -43,7 +43,10 @@ def main() -> None:
     parser.add_argument("--blocks", type=int, default=7)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
-    print(f"{'scenario':<18} {'fcl objects':>11} {'collision us':>13} {'clearance us':>13} {'ratio':>6}")
+    print(
+        f"{'scenario':<18} {'fcl objects':>11} {'collision us':>13} "
+        f"{'clearance us':>13} {'ratio':>6}"
+    )
     for path in args.scenarios:
         scenario = load_scenario(path)
         world = CollisionWorld(scenario)

@@ -314,16 +314,16 @@ def thin_wall() -> dict:
 
 
 def window_wall() -> dict:
-    y0, y1, z0, z1 = 17.6, 22.4, 17.1, 22.9  # window 4.8 (y) x 5.8 (z)
+    y0, y1, z0, z1 = 17.6, 22.4, 16.0, 24.0  # window 4.8 (y) x 8 (z)
     obstacles = [
-        box([39, 0, 0], [41, y0, 40]),
-        box([39, y1, 0], [41, 40, 40]),
-        box([39, y0, 0], [41, y1, z0]),
-        box([39, y0, z1], [41, y1, 40]),
+        box([39.5, 0, 0], [40.5, y0, 40]),
+        box([39.5, y1, 0], [40.5, 40, 40]),
+        box([39.5, y0, 0], [40.5, y1, z0]),
+        box([39.5, y0, z1], [40.5, y1, 40]),
     ]
     return scenario(
         "window_wall",
-        "a wall with one 4.8 x 5.8 window: the ellipsoid (5 wide "
+        "a wall 1 thick with one 4.8 x 8 window: the ellipsoid (5 wide "
         "in y at the start) must roll by 90 degrees about x to pass",
         3,
         [0, 0, 0],
@@ -368,17 +368,17 @@ def box_field(seed: int = 11, count: int = 40) -> dict:
 
 
 def narrow_tunnel() -> dict:
-    y0, y1, z0, z1 = 17.1, 22.9, 17.6, 22.4  # tunnel 5.8 (y) x 4.8 (z): 0.4 of clearance
+    y0, y1, z0, z1 = 16.7, 23.3, 17.2, 22.8  # tunnel 6.6 (y) x 5.6 (z): 0.8 of clearance
     obstacles = [
-        box([30, 0, 0], [70, y0, 40]),
-        box([30, y1, 0], [70, 40, 40]),
-        box([30, y0, 0], [70, y1, z0]),
-        box([30, y0, z1], [70, y1, 40]),
+        box([38, 0, 0], [62, y0, 40]),
+        box([38, y1, 0], [62, 40, 40]),
+        box([38, y0, 0], [62, y1, z0]),
+        box([38, y0, z1], [62, y1, 40]),
     ]
     return scenario(
         "narrow_tunnel",
-        "a 40-long tunnel with 0.4 of clearance around the "
-        "ellipsoid's cross-section: every edge inside it needs thin guards",
+        "a 24-long tunnel with 0.8 of clearance around the ellipsoid's cross-section: "
+        "the robot must stay aligned with it, and every edge inside needs thin guards",
         3,
         [0, 0, 0],
         [100, 40, 40],

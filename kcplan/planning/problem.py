@@ -14,6 +14,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from kcplan.planning.names import PLANNER_NAMES
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.world.collision import CollisionWorld
@@ -34,25 +35,31 @@ class PlannerSpec:
 
 PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
-        og.RRTConnect, True, description="stock RRT-Connect, edges certified by KC guards "
-        "(exact fallback); OMPL's default range (0.2 x the space's maximum extent)"
+        og.RRTConnect,
+        True,
+        description="stock RRT-Connect, edges certified by KC guards "
+        "(exact fallback); OMPL's default range (0.2 x the space's maximum extent)",
     ),
     "kc-prm": PlannerSpec(
-        og.PRM, True, description="stock PRM, roadmap edges certified by KC guards (exact "
-        "fallback)"
+        og.PRM, True, description="stock PRM, roadmap edges certified by KC guards (exact fallback)"
     ),
     "kc-rrtconnect-discrete": PlannerSpec(
-        og.RRTConnect, True, "discrete", "RRT-Connect with one midpoint guard, then OMPL-"
-        "style sampling (the design card's plain variant; not exact)"
+        og.RRTConnect,
+        True,
+        "discrete",
+        "RRT-Connect with one midpoint guard, then OMPL-"
+        "style sampling (the design card's plain variant; not exact)",
     ),
     "rrtconnect": PlannerSpec(og.RRTConnect, False, description="stock RRT-Connect"),
     "prm": PlannerSpec(og.PRM, False, description="stock PRM"),
     "rrt": PlannerSpec(og.RRT, False, description="stock RRT"),
     "rrtstar": PlannerSpec(og.RRTstar, False, description="stock RRT* (runs to the time limit)"),
     "bitstar": PlannerSpec(og.BITstar, False, description="stock BIT* (runs to the time limit)"),
-}  # fmt: skip
+}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
 default discrete motion validator at the default resolution (1 % of the space extent)."""
+if tuple(PLANNERS) != PLANNER_NAMES:  # pragma: no cover - keeps the CLI's list honest
+    raise ImportError("kcplan.planning.names.PLANNER_NAMES is out of date")
 
 _SEEDED: list[int] = []
 ou.setLogLevel(ou.LOG_WARN)

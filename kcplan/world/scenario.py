@@ -23,6 +23,7 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
+from kcplan.files import write_text_atomic
 from kcplan.geometry.pose import quaternion_matrix
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.world.mesh import read_mesh
@@ -498,12 +499,6 @@ def scenario_to_dict(scenario: Scenario) -> dict:
 def dump_scenario(scenario: Scenario | dict, path: str | os.PathLike) -> None:
     """Write a scenario (or its dict) as YAML, atomically (temporary file, then rename)."""
     data = scenario if isinstance(scenario, dict) else scenario_to_dict(scenario)
-    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
-    target = Path(path)
-    tmp = target.with_name(f".{target.name}.tmp{os.getpid()}")
-    try:
-        tmp.write_text(text)
-        os.replace(tmp, target)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    write_text_atomic(
+        path, yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
+    )

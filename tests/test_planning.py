@@ -1,0 +1,250 @@
+"""The KC motion validator: edge algebra against OMPL, soundness, planners, commands."""
+
+import glob
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from ompl import base as ob
+
+from kcplan.cli import main
+from kcplan.geometry.pose import Edge, pose_frame
+from kcplan.geometry.rotations import log_rotation
+from kcplan.planning.certificate import EdgeCertifier, GuardLadder
+from kcplan.planning.problem import PLANNERS, plan
+from kcplan.planning.states import set_state, state_pose, state_space
+from kcplan.planning.verify import verify_path
+from kcplan.world import CollisionWorld, load_scenario, parse_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+SUITE = sorted(glob.glob(str(ROOT / "scenarios" / "*" / "*.yaml")))
+
+
+def random_pose(rng, n, low, high):
+    t = rng.uniform(low, high, n)
+    if n == 2:
+        return np.array([*t, rng.uniform(-np.pi, np.pi)])
+    q = rng.normal(size=4)
+    return np.concatenate([t, q / np.linalg.norm(q)])
+
+
+def relative_xi(pose_from, pose_to, n):
+    """KC coordinates of ``pose_to`` seen from ``pose_from`` (exact, via matrices)."""
+    Ra, ta = pose_frame(pose_from, n)
+    Rb, tb = pose_frame(pose_to, n)
+    return np.concatenate([np.atleast_1d(log_rotation(Ra.T @ Rb)), Ra.T @ (tb - ta)])
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_edge_matches_ompl_interpolation(n):
+    rng = np.random.default_rng(n)
+    space = state_space([-10] * n, [10] * n)
+    si = ob.SpaceInformation(space)
+    a, b, out = si.allocState(), si.allocState(), si.allocState()
+    for _ in range(300):
+        p1, p2 = random_pose(rng, n, -10, 10), random_pose(rng, n, -10, 10)
+        set_state(a, p1, n)
+        set_state(b, p2, n)
+        edge = Edge(p1, p2, n)
+        for s in rng.uniform(0, 1, 3):
+            space.interpolate(a, b, float(s), out)
+            R_ompl, t_ompl = pose_frame(state_pose(out, n), n)
+            R_edge, t_edge = pose_frame(edge.pose(s), n)
+            assert np.allclose(t_ompl, t_edge, atol=1e-9)
+            assert np.allclose(R_ompl, R_edge, atol=1e-9)
+            # midpoint-guard algebra: seen from q(m), q(s) has xi = (s - m) * direction(m)
+            m = float(rng.uniform(0, 1))
+            xi = relative_xi(edge.pose(m), edge.pose(s), n)
+            assert np.allclose(xi, (s - m) * edge.direction(m), atol=1e-8)
+
+
+def random_world(rng, n, a):
+    """Random obstacles around a 40-wide box, including thin walls."""
+    obstacles = []
+    for _ in range(int(rng.integers(2, 7))):
+        c = rng.uniform(-20, 20, n).tolist()
+        kind = rng.integers(3)
+        if kind == 0:  # thin wall
+            size = [float(rng.uniform(0.01, 0.2))] + [float(rng.uniform(5, 30))] * (n - 1)
+            obstacles.append({"box": {"center": c, "size": rng.permutation(size).tolist()}})
+        elif kind == 1:
+            key = "circle" if n == 2 else "sphere"
+            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.5, 5))}})
+        else:
+            obstacles.append({"box": {"center": c, "size": rng.uniform(1, 8, n).tolist()}})
+    data = {
+        "name": "random",
+        "dimension": n,
+        "bounds": {"low": [-25] * n, "high": [25] * n},
+        "robot": {"semi_axes": list(a)},
+        "start": {"position": [0] * n},
+        "goal": {"position": [1] + [0] * (n - 1)},
+        "obstacles": obstacles,
+    }
+    return CollisionWorld(parse_scenario(data, check=False))
+
+
+@pytest.mark.parametrize(
+    "n, shapes, edges_per_world",
+    [(2, [[5, 3.5], [1, 0.4], [3, 3], [8, 1]], 40), (3, [[4, 2.5, 2], [1, 1, 0.3]], 25)],
+)
+def test_accepted_edges_are_free_and_colliding_edges_rejected(n, shapes, edges_per_world):
+    """Thousands of random edges: accepted => free under gap-free verification;
+    a collision found by dense sampling => rejected."""
+    rng = np.random.default_rng(100 + n)
+    accepted = rejected_with_collision = 0
+    for a in shapes:
+        ladder = GuardLadder(a, (0.01, 0.05, 0.2) if n == 3 else None)
+        for _ in range(12 if n == 2 else 10):
+            world = random_world(rng, n, a)
+            certifier = EdgeCertifier(world, a, ladder)
+            for _ in range(edges_per_world):
+                p1 = random_pose(rng, n, -22, 22)
+                if world.in_collision(p1):
+                    continue
+                p2 = p1.copy()
+                p2[:n] += rng.normal(0, rng.choice([1.0, 5.0, 15.0]), n)
+                p2[n:] = random_pose(rng, n, 0, 1)[n:] if rng.random() < 0.5 else p1[n:]
+                ok = certifier.check(p1, p2)
+                edge = Edge(p1, p2, n)
+                dense = world.in_collision_many([edge.pose(s) for s in np.linspace(0, 1, 400)])
+                if ok:
+                    accepted += 1
+                    assert not dense.any()
+                    assert not verify_path(world, [p1, p2]).collides
+                elif dense.any():
+                    rejected_with_collision += 1
+    assert accepted > 100 and rejected_with_collision > (50 if n == 2 else 10)
+
+
+def test_counters_add_up():
+    s = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
+    world = CollisionWorld(s)
+    certifier = EdgeCertifier(world)
+    assert certifier.check(s.start, s.start + np.array([3.0, 0.0, 0.1]))
+    c = certifier.counters
+    assert c["edges"] == 1 and c["certified_one_guard"] == 1 and c["guards"] == 1
+    assert world.counters == {"collision_queries": 1, "distance_queries": 1}
+    assert not certifier.check(s.start, np.array([45.0, 35.0, 0.0]))  # end inside a disc
+    assert c["rejected_end_state"] == 1 and world.counters["distance_queries"] == 1
+    long_edge = certifier.check(s.start, np.array([8.0, 75.0, 0.0]))
+    assert long_edge and c["guards"] == world.counters["distance_queries"] > 2
+    assert c["bisection_nodes"] == c["guards"] - 2
+
+
+@pytest.mark.parametrize("path", SUITE, ids=lambda p: Path(p).stem)
+@pytest.mark.parametrize("planner", ["kc-rrtconnect", "kc-prm"])
+def test_kc_planners_never_return_colliding_paths(path, planner):
+    scenario = load_scenario(path)
+    result = plan(scenario, planner, time_limit=4.0, seed=1)
+    if not result.solved:
+        pytest.skip(f"{planner} did not solve {scenario.name} in 4 s (hard narrow passage)")
+    check = verify_path(CollisionWorld(scenario), result.states)
+    assert not check.collides, check
+    assert np.allclose(result.states[0], scenario.start) and np.allclose(
+        result.states[-1], scenario.goal
+    )
+
+
+@pytest.mark.parametrize("planner", [p for p in PLANNERS if not p.startswith("kc")])
+def test_stock_planners_run_through_the_same_setup(planner):
+    scenario = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
+    result = plan(scenario, planner, time_limit=1.0, seed=1)
+    assert result.solved
+    assert result.counters["checker_calls"] > 0 and "kc_edges" not in result.counters
+
+
+def test_thin_wall_stock_collides_where_kc_never_does():
+    """OMPL's default resolution steps over a 0.1 wall; the KC validator does not."""
+    scenario = load_scenario(ROOT / "scenarios" / "2d" / "thin_wall.yaml")
+    world = CollisionWorld(scenario)
+    stock = [plan(scenario, "rrtconnect", 2.0, world=world) for _ in range(6)]
+    kc = [plan(scenario, "kc-rrtconnect", 4.0, world=world) for _ in range(6)]
+    stock_bad = sum(verify_path(world, r.states).collides for r in stock if r.solved)
+    kc_bad = sum(verify_path(world, r.states).collides for r in kc if r.solved)
+    assert sum(r.solved for r in kc) >= 5
+    assert kc_bad == 0
+    assert stock_bad >= 1
+
+
+def test_plan_and_verify_commands(tmp_path, capsys):
+    scen = str(ROOT / "scenarios" / "2d" / "narrow_corridor.yaml")
+    out, png = tmp_path / "p.json", tmp_path / "p.png"
+    code = main(["plan", scen, "--seed", "1", "-o", str(out), "--plot", str(png), "--guards"])
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "solved by kc-rrtconnect" in text and "kc validator" in text
+    doc = json.loads(out.read_text())
+    assert doc["solved"] and doc["dimension"] == 2 and len(doc["states"][0]) == 3
+    assert doc["counters"]["kc_edges"] > 0 and png.stat().st_size > 10_000
+    assert main(["verify", scen, str(out)]) == 0
+    assert "clean:" in capsys.readouterr().out
+    # a straight path through the wall block collides: exit 1 with the pose
+    doc["states"] = [[10, 30, 0], [60, 45, 0]]
+    out.write_text(json.dumps(doc))
+    assert main(["verify", scen, str(out)]) == 1
+    assert "COLLISION on edge 0" in capsys.readouterr().out
+    out.write_text("{not json")
+    assert main(["verify", scen, str(out)]) == 2
+    assert "expected a JSON path file" in capsys.readouterr().err
+    out.write_text(json.dumps({"states": [[1, 2, 3, 4]]}))
+    assert main(["verify", scen, str(out)]) == 2
+    assert "states: expected a non-empty list of poses with 3 numbers" in capsys.readouterr().err
+    assert main(["plan", scen, "--planner", "nope"]) == 2
+    assert main(["plan", scen, "--time", "-1"]) == 2
+
+
+def test_plan_exit_code_1_when_unsolvable(tmp_path, capsys):
+    data = {
+        "name": "boxed_goal",
+        "dimension": 2,
+        "bounds": {"low": [0, 0], "high": [60, 60]},
+        "robot": {"semi_axes": [2, 1]},
+        "start": {"position": [5, 5]},
+        "goal": {"position": [40, 40]},
+        "obstacles": [
+            {"box": {"center": [40, 30], "size": [20, 2]}},
+            {"box": {"center": [40, 50], "size": [20, 2]}},
+            {"box": {"center": [30, 40], "size": [2, 20]}},
+            {"box": {"center": [50, 40], "size": [2, 20]}},
+        ],
+    }
+    path = tmp_path / "boxed.yaml"
+    path.write_text(json.dumps(data))  # JSON is YAML
+    out = tmp_path / "p.json"
+    assert main(["plan", str(path), "--time", "0.5", "-o", str(out)]) == 1
+    assert "NOT solved" in capsys.readouterr().out
+    assert json.loads(out.read_text())["solved"] is False
+
+
+def test_own_setup_example_runs():
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "own_setup_example.py")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "solved:" in proc.stdout and "validator counters" in proc.stdout
+    assert "leaked" not in proc.stderr
+
+
+def test_ladder_reach_is_the_gauge():
+    ladder = GuardLadder([5.0, 3.5], (0.08,))
+    from kcplan.kc import ConvexLowerBound
+
+    bound = ConvexLowerBound([5.0, 3.5], 0.08)
+    rng = np.random.default_rng(3)
+    for v in rng.normal(size=(50, 3)):
+        plus, minus = ladder.reach(0, v)
+        assert plus == pytest.approx(bound.reach(v)) and minus == pytest.approx(bound.reach(-v))
+        assert bound.contains(0.999 * plus * v) and not bound.contains(1.001 * plus * v)
+    assert ladder.level_for(0.08 * 5.0) == 0 and ladder.level_for(0.079 * 5.0) == -1
+    assert math.isinf(ladder.reach(0, np.zeros(3))[0])
