@@ -228,6 +228,18 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
     ax.set_zlabel("z")
 
 
+def _scenario_axes(scenario: Scenario):
+    """A figure sized to the map: a 2D top view, or 3D axes."""
+    if scenario.dimension == 2:
+        low, high = scenario.bounds
+        w, h = high - low
+        fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * h / w) + 0.6))
+    else:
+        fig = plt.figure(figsize=(8, 7))
+        ax = fig.add_subplot(projection="3d")
+    return fig, ax
+
+
 def plot_scenario(
     scenario: Scenario,
     path: str | os.PathLike,
@@ -236,13 +248,7 @@ def plot_scenario(
     guards: float | None = None,
 ) -> None:
     """Draw a scenario (2D top view or 3D perspective) into an image file."""
-    if scenario.dimension == 2:
-        low, high = scenario.bounds
-        w, h = high - low
-        fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * h / w) + 0.6))
-    else:
-        fig = plt.figure(figsize=(8, 7))
-        ax = fig.add_subplot(projection="3d")
+    fig, ax = _scenario_axes(scenario)
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
     ax.set_title(title or "\n".join(textwrap.wrap(heading, 100)), fontsize=9)
@@ -272,13 +278,7 @@ def plot_path(
     if given, guards as ``(pose, inflation)`` pairs (dashed)."""
     n = scenario.dimension
     poses = path_poses(states, n) if len(states) else []
-    if n == 2:
-        low, high = scenario.bounds
-        w, h = high - low
-        fig, ax = plt.subplots(figsize=(8, max(3.0, 8 * h / w) + 0.6))
-    else:
-        fig = plt.figure(figsize=(8, 7))
-        ax = fig.add_subplot(projection="3d")
+    fig, ax = _scenario_axes(scenario)
     draw_scenario(ax, scenario, poses)
     if len(states):
         P = np.asarray(states)

@@ -43,6 +43,17 @@ def box(lo, hi, **extra) -> dict:
     }
 
 
+def slab_with_hole(x0, x1, y0, y1, z0, z1, lo, hi) -> list[dict]:
+    """Four boxes filling the slab ``x0..x1`` over ``lo..hi`` in y and z, except the
+    rectangular hole ``y0..y1`` x ``z0..z1``."""
+    return [
+        box([x0, lo, lo], [x1, y0, hi]),
+        box([x0, y1, lo], [x1, hi, hi]),
+        box([x0, y0, lo], [x1, y1, z0]),
+        box([x0, y0, z1], [x1, y1, hi]),
+    ]
+
+
 def scenario(name, description, n, low, high, start, goal, obstacles, a=None, eps=None) -> dict:
     a = a or (A2 if n == 2 else A3)
     eps = eps or (EPS2 if n == 2 else EPS3)
@@ -315,12 +326,7 @@ def thin_wall() -> dict:
 
 def window_wall() -> dict:
     y0, y1, z0, z1 = 17.6, 22.4, 16.0, 24.0  # window 4.8 (y) x 8 (z)
-    obstacles = [
-        box([39.5, 0, 0], [40.5, y0, 40]),
-        box([39.5, y1, 0], [40.5, 40, 40]),
-        box([39.5, y0, 0], [40.5, y1, z0]),
-        box([39.5, y0, z1], [40.5, y1, 40]),
-    ]
+    obstacles = slab_with_hole(39.5, 40.5, y0, y1, z0, z1, 0, 40)
     return scenario(
         "window_wall",
         "a wall 1 thick with one 4.8 x 8 window: the ellipsoid (5 wide "
@@ -369,12 +375,7 @@ def box_field(seed: int = 11, count: int = 40) -> dict:
 
 def narrow_tunnel() -> dict:
     y0, y1, z0, z1 = 16.7, 23.3, 17.2, 22.8  # tunnel 6.6 (y) x 5.6 (z): 0.8 of clearance
-    obstacles = [
-        box([38, 0, 0], [62, y0, 40]),
-        box([38, y1, 0], [62, 40, 40]),
-        box([38, y0, 0], [62, y1, z0]),
-        box([38, y0, z1], [62, y1, 40]),
-    ]
+    obstacles = slab_with_hole(38, 62, y0, y1, z0, z1, 0, 40)
     return scenario(
         "narrow_tunnel",
         "a 24-long tunnel with 0.8 of clearance around the ellipsoid's cross-section: "
@@ -392,10 +393,7 @@ def peg_in_hole() -> dict:
     y0, y1, z0, z1 = 17.1, 22.9, 17.6, 22.4  # cavity 5.8 x 4.8, 12 deep
     obstacles = [
         box([62, 10, 10], [70, 30, 30]),
-        box([50, 10, 10], [62, y0, 30]),
-        box([50, y1, 10], [62, 30, 30]),
-        box([50, y0, 10], [62, y1, z0]),
-        box([50, y0, z1], [62, y1, 30]),
+        *slab_with_hole(50, 62, y0, y1, z0, z1, 10, 30),
     ]
     s = math.sin(math.pi / 4)
     return scenario(
