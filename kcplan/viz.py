@@ -5,7 +5,6 @@ Files are written atomically (temporary file, then rename)."""
 from __future__ import annotations
 
 import os
-import tempfile
 import textwrap
 from pathlib import Path
 
@@ -17,6 +16,7 @@ import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from scipy.spatial import ConvexHull  # noqa: E402
 
+from kcplan.files import atomic_output  # noqa: E402
 from kcplan.geometry.pose import Edge, pose_frame  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
 from kcplan.world.scenario import Scenario  # noqa: E402
@@ -33,17 +33,11 @@ __all__ = [
 
 def save_figure(fig: plt.Figure, path: str | os.PathLike, dpi: int = 120) -> None:
     """Save ``fig`` to ``path`` atomically (no half-written file on failure) and close it."""
-    target = Path(path)
-    suffix = target.suffix or ".png"
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent or ".")
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        os.replace(tmp, target)
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight", format=Path(path).suffix[1:] or "png")
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def _hull_faces(ax, points: np.ndarray, color: str, alpha: float = 0.25) -> None:

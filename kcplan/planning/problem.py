@@ -88,6 +88,7 @@ class PlanResult:
     simplify_time: float
     states: list = field(default_factory=list)  # flat poses of the (simplified) path
     length: float = 0.0  # OMPL path length (SE2: translation + 0.5 * |yaw change| ...)
+    raw_length: float = 0.0  # the same, of the path solve() returned, before simplification
     seed: int | None = None
     counters: dict = field(default_factory=dict)
 
@@ -100,6 +101,7 @@ class PlanResult:
             "dimension": self.dimension,
             "states": self.states,
             "length": self.length,
+            "raw_length": self.raw_length,
             "time": self.time,
             "simplify_time": self.simplify_time,
             "seed": self.seed,
@@ -171,8 +173,9 @@ def plan(
         ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
         solve_time = float(ss.getLastPlanComputationTime())
         solved = bool(ss.haveExactSolutionPath())
-        simplify_time, states, length = 0.0, [], 0.0
+        simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
         if solved:
+            raw_length = float(ss.getSolutionPath().length())
             if simplify:
                 t0 = time.perf_counter()
                 ss.simplifySolution(float(time_limit))
@@ -192,5 +195,15 @@ def plan(
         if validator is not None:
             validator.close()
     return PlanResult(
-        scenario.name, planner, n, solved, solve_time, simplify_time, states, length, seed, counters
+        scenario.name,
+        planner,
+        n,
+        solved,
+        solve_time,
+        simplify_time,
+        states,
+        length,
+        raw_length,
+        seed,
+        counters,
     )

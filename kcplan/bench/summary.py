@@ -1,0 +1,161 @@
+"""Per scenario and planner statistics of a campaign: ``summary.csv`` and ``summary.md``.
+
+Conventions: times are seconds of ``solve()``; a run that did not solve (or whose worker
+failed) counts at the time limit in ``median_time`` and ``p90_time``, so a planner cannot
+look fast by failing; ``median_fcl_queries`` (collision plus distance queries, state checks
+and guards together) is over runs whose worker finished; ``median_length`` is over solved
+runs (OMPL path length after simplification). A kc planner's *twin* is the stock planner
+it wraps (``kc-prm`` -> ``prm``); ratios are twin / kc, so above 1 means kc wins.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from kcplan.planning.names import PLANNER_NAMES
+
+__all__ = ["SUMMARY_COLUMNS", "twin_of", "summarize", "summary_csv", "summary_markdown"]
+
+SUMMARY_COLUMNS = (
+    "scenario",
+    "planner",
+    "runs",
+    "solved",
+    "success_rate",
+    "median_time",
+    "p90_time",
+    "median_fcl_queries",
+    "median_length",
+    "colliding_paths",
+)
+"""The first columns of ``summary.csv``, in this order (issue 5)."""
+
+EXTRA_COLUMNS = (
+    "failed_runs",
+    "median_collision_queries",
+    "median_distance_queries",
+    "median_kc_guards",
+    "median_certified_edges",
+    "median_simplify_time",
+    "twin",
+    "time_ratio",
+    "query_ratio",
+)
+
+
+def twin_of(planner: str) -> str | None:
+    """The stock planner a kc planner wraps, or None (``kc-rrtconnect-discrete`` ->
+    ``rrtconnect``)."""
+    if not planner.startswith("kc-"):
+        return None
+    base = planner[3:].removesuffix("-discrete")
+    return base if base in PLANNER_NAMES else None
+
+
+def _median(values: Sequence[float]) -> float:
+    return float(np.median(values)) if len(values) else math.nan
+
+
+def summarize(records: Sequence[dict]) -> list[dict]:
+    """One row per (scenario, planner), in the order they first appear in ``records``."""
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for r in records:
+        groups.setdefault((r["scenario_name"], r["planner"]), []).append(r)
+    rows = []
+    for (scenario, planner), runs in groups.items():
+        finished = [r for r in runs if r["status"] == "ok"]
+        solved = [r for r in finished if r["solved"]]
+        charged = [r["time"] if r["solved"] else r["time_limit"] for r in runs]
+
+        def counter(name: str, runs=finished) -> float:
+            return _median([r["counters"][name] for r in runs if name in r["counters"]])
+
+        certified = [
+            r["counters"]["kc_edges"] - r["counters"]["kc_rejected"]
+            for r in finished
+            if "kc_edges" in r["counters"]
+        ]
+        rows.append(
+            {
+                "scenario": scenario,
+                "planner": planner,
+                "runs": len(runs),
+                "solved": len(solved),
+                "success_rate": len(solved) / len(runs),
+                "median_time": _median(charged),
+                "p90_time": float(np.percentile(charged, 90)),
+                "median_fcl_queries": counter("fcl_queries"),
+                "median_length": _median([r["length"] for r in solved]),
+                "colliding_paths": sum(bool(r["collides"]) for r in solved),
+                "failed_runs": len(runs) - len(finished),
+                "median_collision_queries": counter("collision_queries"),
+                "median_distance_queries": counter("distance_queries"),
+                "median_kc_guards": counter("kc_guards"),
+                "median_certified_edges": _median(certified),
+                "median_simplify_time": _median([r["simplify_time"] for r in solved]),
+                "twin": twin_of(planner) or "",
+            }
+        )
+    by_key = {(r["scenario"], r["planner"]): r for r in rows}
+    for row in rows:
+        twin = by_key.get((row["scenario"], row["twin"]))
+        row["time_ratio"] = _ratio(twin, row, "median_time")
+        row["query_ratio"] = _ratio(twin, row, "median_fcl_queries")
+    return rows
+
+
+def _ratio(twin: dict | None, row: dict, column: str) -> float:
+    if twin is None or not row[column] > 0:
+        return math.nan
+    return twin[column] / row[column]
+
+
+def _cell(v: object) -> str:
+    if isinstance(v, float):
+        return "" if math.isnan(v) else f"{v:.6g}"
+    return str(v)
+
+
+def summary_csv(rows: Sequence[dict]) -> str:
+    """CSV text: :data:`SUMMARY_COLUMNS`, then the extra columns; NaN is an empty cell."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    columns = SUMMARY_COLUMNS + EXTRA_COLUMNS
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([_cell(row[c]) for c in columns])
+    return buf.getvalue()
+
+
+def _fmt(v: float, spec: str) -> str:
+    return "–" if math.isnan(v) else format(v, spec)
+
+
+def summary_markdown(rows: Sequence[dict], title: str = "Benchmark summary") -> str:
+    """A Markdown table of the rows, with kc / stock-twin ratios."""
+    out = [
+        f"# {title}",
+        "",
+        "Times are seconds in `solve()`, unsolved runs counted at the time limit; FCL "
+        "queries are collision plus distance queries; *colliding* counts returned paths that "
+        "gap-free verification (`kcplan verify`) found in collision. The last two columns "
+        "compare a kc planner with its stock twin: twin / kc, so above 1 means kc wins.",
+        "",
+        "| scenario | planner | solved | median time | p90 time | median FCL queries "
+        "| median length | colliding | failed | time twin/kc | queries twin/kc |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['scenario']} | {r['planner']} | {r['solved']}/{r['runs']} "
+            f"| {_fmt(r['median_time'], '.3f')} | {_fmt(r['p90_time'], '.3f')} "
+            f"| {_fmt(r['median_fcl_queries'], '.0f')} | {_fmt(r['median_length'], '.2f')} "
+            f"| {r['colliding_paths']} | {r['failed_runs']} "
+            f"| {_fmt(r['time_ratio'], '.2f')} | {_fmt(r['query_ratio'], '.2f')} |"
+        )
+    return "\n".join(out) + "\n"
