@@ -327,6 +327,42 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _cmd_import(args: argparse.Namespace) -> int:
+    from kcplan.maps import MapImportError
+    from kcplan.world import ScenarioError, dump_scenario, parse_scenario
+
+    out = Path(args.output)
+    if out.suffix not in (".yaml", ".yml"):
+        raise InputError(f"{out}: -o: expected a .yaml file name, got {out.name!r}")
+    if not out.parent.is_dir():
+        raise InputError(f"{out}: -o: expected an existing folder, got {out.parent}")
+    try:
+        if args.source == "hrm":
+            from kcplan.maps.hrm import import_hrm
+
+            if not Path(args.resources).is_dir():
+                raise MapImportError(f"{args.resources}: expected HRM's resources folder")
+            data = import_hrm(args.resources, args.map, args.dimension, out, args.inflation)
+        else:
+            from kcplan.maps.movingai import import_movingai
+
+            if (args.scen is None) != (args.index is None) and args.index is not None:
+                raise MapImportError("--index: expected --scen FILE.scen as well")
+            data = import_movingai(
+                args.map_file, args.scen, args.index or 0, args.cell, args.robot, args.inflation
+            )
+        scenario = parse_scenario(data, str(out), out.parent, check=True)
+    except (MapImportError, ScenarioError) as err:
+        raise InputError(str(err)) from None
+    dump_scenario(data, out)
+    print(
+        f"{out}: {scenario.name}, {scenario.dimension}D, {len(data['obstacles'])} obstacles, "
+        f"robot {[float(a) for a in scenario.semi_axes]}"
+    )
+    print(data["description"])
+    return 0
+
+
 def _rows_csv(rows: Sequence[dict]) -> str:
     import csv
     import io
@@ -589,6 +625,48 @@ def build_parser() -> argparse.ArgumentParser:
         help="output folder (default pick-place)",
     )
     p.set_defaults(handler=_cmd_pick_place)
+
+    p = sub.add_parser(
+        "import",
+        help="convert public benchmark maps (HRM, Moving AI) into scenario files",
+        description="Convert a public benchmark map into a kcplan scenario YAML; the "
+        "result is validated (start and goal free) before it is written.",
+    )
+    kinds = p.add_subparsers(dest="source", required=True, parser_class=_Parser)
+    q = kinds.add_parser(
+        "hrm",
+        help="a Highway RoadMap map (CSV, github.com/ChirikjianLab/hrm)",
+        description="Convert an HRM map with its single-body robot. Superellipses become "
+        "circumscribed polygons (outer approximations), the arena is kept by walls outside "
+        "its inscribed polygon (3D: a mesh surface and an inscribed box for the centre); "
+        "the bound on the geometric error is in the scenario's description.",
+    )
+    q.add_argument("resources", metavar="RESOURCES_DIR", help="HRM's resources folder")
+    q.add_argument("--map", required=True, help="map name, e.g. ellipse_maze or maze")
+    q.add_argument("--dimension", type=int, choices=(2, 3), default=2, help="2 (default) or 3")
+    q.add_argument("--inflation", type=_positive_float, default=0.1, help="guard inflation")
+    q.add_argument("-o", "--output", required=True, metavar="SCENARIO.yaml")
+    q.set_defaults(handler=_cmd_import)
+    q = kinds.add_parser(
+        "movingai",
+        help="a Moving AI grid map (.map, optional .scen row)",
+        description="Convert a Moving AI grid map: blocked cells become boxes merged into "
+        "rectangles, walls keep the robot on the map, start and goal from a .scen row.",
+    )
+    q.add_argument("map_file", metavar="MAP.map")
+    q.add_argument("--scen", metavar="FILE.scen", help="scenario file with start/goal rows")
+    q.add_argument("--index", type=int, help="0-based row of --scen (default 0)")
+    q.add_argument("--cell", type=_positive_float, default=1.0, help="cell size (default 1)")
+    q.add_argument(
+        "--robot",
+        nargs=2,
+        type=_positive_float,
+        metavar=("A1", "A2"),
+        help="robot semi-axes (default 0.7 and 0.4 times the narrowest corridor)",
+    )
+    q.add_argument("--inflation", type=_positive_float, default=0.1, help="guard inflation")
+    q.add_argument("-o", "--output", required=True, metavar="SCENARIO.yaml")
+    q.set_defaults(handler=_cmd_import)
     return parser
 
 

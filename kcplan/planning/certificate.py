@@ -12,6 +12,7 @@ coordinates seen from a pose on it move on a line through the origin
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import math
 import os
@@ -112,22 +113,23 @@ class GuardLadder:
         levels = tuple(sorted(float(e) for e in (inflations or DEFAULT_LADDER[n])))
         self.semi_axes, self.inflations = a, np.array(levels)
         rows = [_halfspaces(tuple(a.tolist()), e) for e in levels]
-        self._A = [A for A, _ in rows]
-        self._c = [c for _, c in rows]
+        # rows scaled to A_i / c_i (c > 0: the origin is interior), so the gauge needs
+        # only a matrix-vector product and two reductions
+        self._scaled = [A / c[:, None] for A, c in rows]
+        self._levels = levels
         self.scale = float(a.max())
 
     def level_for(self, clearance: float) -> int:
         """Index of the largest inflation a guard with this clearance allows, or -1."""
-        return int(np.searchsorted(self.inflations, clearance / self.scale, side="right")) - 1
+        return bisect.bisect_right(self._levels, clearance / self.scale) - 1
 
     def reach(self, level: int, direction: np.ndarray) -> tuple[float, float]:
-        """How far ``P_eps`` extends along ``+direction`` and ``-direction`` (gauge)."""
-        proj = self._A[level] @ direction
-        c = self._c[level]
-        pos, neg = proj > 0, proj < 0
-        plus = float((c[pos] / proj[pos]).min()) if pos.any() else math.inf
-        minus = float((c[neg] / -proj[neg]).min()) if neg.any() else math.inf
-        return plus, minus
+        """How far ``P_eps = {xi : A xi <= c}`` extends along ``+direction`` and
+        ``-direction``: ``1 / max_i (A_i d / c_i)`` and ``1 / max_i (-A_i d / c_i)``
+        (``inf`` where no row bounds that side)."""
+        proj = self._scaled[level] @ direction
+        top, bottom = float(proj.max()), float(proj.min())
+        return (1.0 / top if top > 0.0 else math.inf, -1.0 / bottom if bottom < 0.0 else math.inf)
 
 
 class EdgeCertifier:
@@ -151,9 +153,10 @@ class EdgeCertifier:
 
     Far from obstacles a guard's clearance ``d`` alone covers more: no robot point moves
     more than ``sweep_speed * |ds|`` (:meth:`Edge.sweep_speed`), so the stretch
-    ``|s - m| < d / sweep_speed`` is free too. Each guard covers the larger of the two
-    stretches on each side (``ball_certified`` counts guards where the ball won); the KC
-    polytope wins near obstacles and for rotations, the ball in open space.
+    ``|s - m| < d / sweep_speed`` is free too. A guard whose ball covers its whole stretch
+    needs no gauge; otherwise it covers the larger of the two stretches on each side
+    (``ball_certified`` counts guards where the ball won); the KC polytope wins near
+    obstacles and for rotations, the ball in open space.
 
     Counters (``counters`` dict): ``edges`` checked, ``certified_one_guard``,
     ``guards`` (clearance queries), ``bisection_nodes`` (guards after the first),
@@ -215,6 +218,15 @@ class EdgeCertifier:
             d = self.world.safe_clearance(pose)
             guards += 1
             level = self.ladder.level_for(d)
+            # the clearance ball alone: no robot point moves more than speed * |s - m|
+            ball = d / speed if speed > 0.0 else math.inf
+            if m - ball <= s0 and m + ball >= s1:  # covers the stretch: no gauge needed
+                c["ball_certified"] += 1
+                c["certified_one_guard"] += guards == 1
+                if self.guard_log is not None:
+                    eps = self.ladder.inflations[level] if level >= 0 else d / self.ladder.scale
+                    self.guard_log.append((pose, float(eps)))
+                continue
             if level < 0 and guards == 1 and d > 0.0 and self.fallback == "discrete":
                 return self._sample(edge, resolution, m, m)
             if level < 0:  # touching (d = 0) or too close to prove anything
@@ -227,7 +239,6 @@ class EdgeCertifier:
                 self.guard_log.append((pose, float(self.ladder.inflations[level])))
             plus, minus = self.ladder.reach(level, edge.direction(m))
             # far from obstacles the clearance ball covers more than the top guard
-            ball = d / speed if speed > 0.0 else math.inf
             if ball > min(plus, minus):
                 c["ball_certified"] += 1
             lo, hi = m - max(minus, ball), m + max(plus, ball)

@@ -14,6 +14,8 @@ import struct
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.files import atomic_output
+
 __all__ = ["MAX_MESH_BYTES", "MAX_MESH_TRIANGLES", "read_mesh", "write_stl"]
 
 MAX_MESH_BYTES = 256 * 2**20
@@ -120,7 +122,7 @@ def _parse_obj(data: bytes) -> tuple[NDArray, NDArray]:
 
 
 def write_stl(path: str | os.PathLike, vertices: NDArray, triangles: NDArray) -> None:
-    """Write a binary STL file (used by the scenario generator script)."""
+    """Write a binary STL file atomically (float32 coordinates, as the format stores)."""
     corners = np.asarray(vertices, dtype="<f4")[np.asarray(triangles)]
     normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
@@ -128,7 +130,7 @@ def write_stl(path: str | os.PathLike, vertices: NDArray, triangles: NDArray) ->
         len(corners), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     )
     rec["n"], rec["v"] = normals, corners
-    with open(path, "wb") as fh:
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
         fh.write(b"kcplan binary STL".ljust(80, b" "))
         fh.write(struct.pack("<I", len(rec)))
         fh.write(rec.tobytes())

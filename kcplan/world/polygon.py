@@ -87,7 +87,7 @@ def simple_polygon(vertices: ArrayLike) -> NDArray[np.float64]:
     if len(p) < 3:
         raise ValueError("expected a polygon with at least 3 non-collinear vertices")
     k = len(p)
-    for i in range(k):
+    for i in range(k if not _turns_once(p) else 0):
         for j in range(i + 1, k):
             if j == i + 1 or (i == 0 and j == k - 1):
                 continue  # neighbouring edges share a vertex by construction
@@ -99,6 +99,18 @@ def simple_polygon(vertices: ArrayLike) -> NDArray[np.float64]:
     if area < 0:
         p = p[::-1].copy()
     return p
+
+
+def _turns_once(p: NDArray) -> bool:
+    """True when every corner turns the same way and the turns add up to one full turn:
+    a convex polygon, necessarily simple, so the O(k^2) edge-pair test can be skipped."""
+    edge = np.roll(p, -1, axis=0) - p
+    nxt = np.roll(edge, -1, axis=0)
+    cross = edge[:, 0] * nxt[:, 1] - edge[:, 1] * nxt[:, 0]
+    if not ((cross > 0).all() or (cross < 0).all()):
+        return False
+    turning = np.arctan2(cross, (edge * nxt).sum(axis=1)).sum()
+    return bool(abs(abs(turning) - 2.0 * np.pi) < 1e-6)
 
 
 def _is_convex(p: NDArray) -> bool:
