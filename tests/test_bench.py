@@ -353,6 +353,13 @@ def test_summary_statistics_by_hand():
     assert math.isnan(stock["time_ratio"])
     assert twin_of("kc-prm") == "prm" and twin_of("kc-rrtconnect-discrete") == "rrtconnect"
     assert twin_of("prm") is None
+    # with only the fine-resolution stock planner in the campaign, it is the twin
+    fine = [
+        dict(r, planner="rrtconnect-fine") if r["planner"] == "rrtconnect" else r for r in records
+    ]
+    rows = {r["planner"]: r for r in summarize(fine)}
+    assert rows["kc-rrtconnect"]["twin"] == "rrtconnect-fine"
+    assert rows["kc-rrtconnect"]["time_ratio"] == 2.0
 
 
 def test_polytope_cache_round_trip_and_repair(tmp_path, monkeypatch):

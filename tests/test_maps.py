@@ -9,6 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from kcplan.cli import main
+from kcplan.maps.hrm import HRM_MAPS
 from kcplan.maps.movingai import (
     free_square_sizes,
     merge_rectangles,
@@ -36,15 +37,7 @@ needs_hrm = pytest.mark.skipif(
 needs_mapf = pytest.mark.skipif(
     not MAPF.is_dir(), reason=f"Moving AI maps not found at {MAPF} (../shared/data/external)"
 )
-HRM_2D = [
-    "ellipse_cluttered",
-    "ellipse_gym_maze",
-    "ellipse_maze",
-    "ellipse_sparse",
-    "superellipse_cluttered",
-    "superellipse_maze1",
-]
-HRM_3D = ["ellipsoid_cluttered", "ellipsoid_maze", "ellipsoid_sparse"]
+HRM_2D, HRM_3D = HRM_MAPS[2], HRM_MAPS[3]
 MAPF_MAPS = ["maze-32-32-2", "maze-32-32-4", "room-32-32-4", "random-32-32-10", "maze-128-128-10"]
 
 
@@ -275,27 +268,9 @@ def test_every_moving_ai_map_converts_and_validates(name, tmp_path, capsys):
 @needs_mapf
 def test_moving_ai_scen_rows_and_planning(tmp_path, capsys):
     out = tmp_path / "m4.yaml"
-    code = main(
-        [
-            "import",
-            "movingai",
-            str(MAPF / "maze-32-32-4.map"),
-            "--scen",
-            str(SCEN / "maze-32-32-4-even-1.scen"),
-            "--index",
-            "1",
-            "-o",
-            str(out),
-        ]
-    )
-    assert code == 0
-    scenario = load_scenario(out)
-    assert "row 1" in scenario.description
-    result = plan(scenario, "kc-rrtconnect", 30.0, seed=2)
-    assert result.solved
-    assert not verify_path(CollisionWorld(scenario), result.states).collides
-    assert (
-        main(
+
+    def convert(index: str) -> int:
+        return main(
             [
                 "import",
                 "movingai",
@@ -303,13 +278,19 @@ def test_moving_ai_scen_rows_and_planning(tmp_path, capsys):
                 "--scen",
                 str(SCEN / "maze-32-32-4-even-1.scen"),
                 "--index",
-                "999",
+                index,
                 "-o",
                 str(out),
             ]
         )
-        == 2
-    )
+
+    assert convert("1") == 0
+    scenario = load_scenario(out)
+    assert "row 1" in scenario.description
+    result = plan(scenario, "kc-rrtconnect", 30.0, seed=2)
+    assert result.solved
+    assert not verify_path(CollisionWorld(scenario), result.states).collides
+    assert convert("999") == 2
     err = capsys.readouterr().err
     assert "--index" in err and len(err.strip().splitlines()) == 1
 

@@ -5,7 +5,8 @@ failed) counts at the time limit in ``median_time`` and ``p90_time``, so a plann
 look fast by failing; ``median_fcl_queries`` (collision plus distance queries, state checks
 and guards together) is over runs whose worker finished; ``median_length`` is over solved
 runs (OMPL path length after simplification). A kc planner's *twin* is the stock planner
-it wraps (``kc-prm`` -> ``prm``); ratios are twin / kc, so above 1 means kc wins.
+it wraps (``kc-prm`` -> ``prm``), or its 0.1 % resolution version (``prm-fine``) when
+only that ran; ratios are twin / kc, so above 1 means kc wins.
 """
 
 from __future__ import annotations
@@ -103,6 +104,9 @@ def summarize(records: Sequence[dict]) -> list[dict]:
         )
     by_key = {(r["scenario"], r["planner"]): r for r in rows}
     for row in rows:
+        if row["twin"] and (row["scenario"], row["twin"]) not in by_key:
+            fine = row["twin"] + "-fine"  # the campaign ran the 0.1 % resolution twin instead
+            row["twin"] = fine if (row["scenario"], fine) in by_key else row["twin"]
         twin = by_key.get((row["scenario"], row["twin"]))
         row["time_ratio"] = _ratio(twin, row, "median_time")
         row["query_ratio"] = _ratio(twin, row, "median_fcl_queries")

@@ -171,12 +171,22 @@ def import_hrm(
     return _import_3d(folder, name, Path(output), inflation)
 
 
+def _read_map(folder: Path, name: str, n: int):
+    """Robot row, arena row, obstacle file and rows, start/goal rows of one map."""
+    shape, pose = (6, 3) if n == 2 else (12, 7)  # CSV widths (HRM's resources/readme.md)
+    robot = "robot_single_body_2D.csv" if n == 2 else "robot_rabbit_3D.csv"
+    obstacles = folder / f"env_{name}_{n}D_obstacle.csv"
+    return (
+        _rows(folder / robot, shape)[0],
+        _rows(folder / f"env_{name}_{n}D_arena.csv", shape)[0],
+        obstacles,
+        _rows(obstacles, shape),
+        _rows(folder / f"setting_{name}_{n}D.csv", pose),
+    )
+
+
 def _import_2d(folder: Path, name: str, inflation: float) -> dict:
-    robot = _rows(folder / "robot_single_body_2D.csv", 6)[0]
-    arena = _rows(folder / f"env_{name}_2D_arena.csv", 6)[0]
-    obstacles_csv = folder / f"env_{name}_2D_obstacle.csv"
-    rows = _rows(obstacles_csv, 6)
-    setting = _rows(folder / f"setting_{name}_2D.csv", 3)
+    robot, arena, obstacles_csv, rows, setting = _read_map(folder, name, 2)
     semi_axes = robot[:2]
     obstacles, worst = [], 0.0
     for i, (a, b, e, cx, cy, theta) in enumerate(rows, start=1):
@@ -238,11 +248,7 @@ def _arena_walls_2d(arena: np.ndarray, robot_size: float):
 
 
 def _import_3d(folder: Path, name: str, output: Path, inflation: float) -> dict:
-    robot = _rows(folder / "robot_rabbit_3D.csv", 12)[0]
-    arena = _rows(folder / f"env_{name}_3D_arena.csv", 12)[0]
-    obstacles_csv = folder / f"env_{name}_3D_obstacle.csv"
-    rows = _rows(obstacles_csv, 12)
-    setting = _rows(folder / f"setting_{name}_3D.csv", 7)
+    robot, arena, obstacles_csv, rows, setting = _read_map(folder, name, 3)
     semi_axes = robot[:3]
     obstacles, worst = [], 0.0
     stem = output.name.removesuffix(".yaml").removesuffix(".yml")

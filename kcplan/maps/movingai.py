@@ -200,7 +200,7 @@ def import_movingai(
     if not (cell > 0 and math.isfinite(cell)):
         raise MapImportError(f"--cell: expected a positive number, got {cell}")
     w = narrowest_corridor(blocked)
-    semi_axes = list(robot) if robot else [0.7 * w * cell, 0.4 * w * cell]
+    semi_axes = list(robot) if robot else [round(0.7 * w * cell, 9), round(0.4 * w * cell, 9)]
     if len(semi_axes) != 2 or not all(a > 0 for a in semi_axes):
         raise MapImportError(f"--robot: expected two positive semi-axes, got {robot}")
     semi_axes = sorted((float(a) for a in semi_axes), reverse=True)

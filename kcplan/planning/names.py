@@ -6,6 +6,8 @@ PLANNER_NAMES = (
     "kc-rrtconnect-discrete",
     "rrtconnect",
     "prm",
+    "rrtconnect-fine",
+    "prm-fine",
     "rrt",
     "rrtstar",
     "bitstar",
