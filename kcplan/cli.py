@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
+import signal
 import sys
 import time
 from collections.abc import Sequence
@@ -297,7 +298,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         f"planners x {args.runs}), {args.time:g} s each, {where}; results in {args.output}",
         file=sys.stderr,
     )
-    records, complete = run_campaign(specs, args.output, executor, Progress(len(specs)))
+    # a batch system's SIGTERM ends the campaign like Ctrl-C: finished runs are reported
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        records, complete = run_campaign(specs, args.output, executor, Progress(len(specs)))
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     if complete:
         executor.shutdown()
     records = ordered(records, specs)
@@ -346,7 +352,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
         else:
             from kcplan.maps.movingai import import_movingai
 
-            if (args.scen is None) != (args.index is None) and args.index is not None:
+            if args.index is not None and args.scen is None:
                 raise MapImportError("--index: expected --scen FILE.scen as well")
             data = import_movingai(
                 args.map_file, args.scen, args.index or 0, args.cell, args.robot, args.inflation

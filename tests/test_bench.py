@@ -251,7 +251,8 @@ def test_worker_error_is_a_failed_run(tmp_path):
     assert record["solved"] is False
 
 
-def test_ctrl_c_leaves_complete_results_for_finished_runs(tmp_path):
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_ctrl_c_leaves_complete_results_for_finished_runs(signum, tmp_path):
     out = tmp_path / "r"
     proc = subprocess.Popen(
         [
@@ -272,13 +273,15 @@ def test_ctrl_c_leaves_complete_results_for_finished_runs(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # a shell starts background jobs with SIGINT ignored, and Python keeps that
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.time() + 120
     while time.time() < deadline:
         if (out / "runs.jsonl").exists() and len(read_records(out / "runs.jsonl")) >= 2:
             break
         time.sleep(0.2)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signum)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err

@@ -25,6 +25,8 @@ from numpy.typing import ArrayLike
 
 from kcplan.files import atomic_output
 from kcplan.geometry import containment as containment_module
+from kcplan.geometry import ellipsoid as ellipsoid_module
+from kcplan.geometry import rotations as rotations_module
 from kcplan.geometry.pose import Edge
 from kcplan.kc import convex as convex_module
 from kcplan.kc.convex import ConvexLowerBound
@@ -59,7 +61,7 @@ def polytope_cache_dir() -> Path | None:
 def _algorithm_digest() -> str:
     # A cached polytope is only reused by the exact code that built it.
     h = hashlib.sha256()
-    for module in (convex_module, containment_module):
+    for module in (convex_module, containment_module, rotations_module, ellipsoid_module):
         h.update(Path(module.__file__).read_bytes())
     return h.hexdigest()[:16]
 
