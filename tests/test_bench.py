@@ -387,3 +387,40 @@ def test_polytope_cache_round_trip_and_repair(tmp_path, monkeypatch):
     certificate._halfspaces.cache_clear()
     monkeypatch.setenv("KCPLAN_CACHE_DIR", "off")
     assert certificate.polytope_cache_dir() is None
+
+
+def test_progress_is_live_on_a_terminal_and_logged_otherwise():
+    import io
+
+    from kcplan.bench.campaign import Progress
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    record = {
+        "scenario_name": "s",
+        "planner": "prm",
+        "run": 0,
+        "seed": 1,
+        "status": "ok",
+        "solved": True,
+        "time": 0.5,
+        "collides": False,
+        "counters": {"fcl_queries": 7},
+    }
+    tty = Terminal()
+    progress = Progress(2, tty)
+    progress.update(record)
+    progress.close()
+    text = tty.getvalue()
+    assert text.startswith("\r[1/2] 0:00 elapsed, ~0:00 left | s prm #0 (seed 1): solved")
+    assert text.endswith("\n") and text.count("\n") == 1  # one live line, ended on close
+    log = io.StringIO()
+    progress = Progress(2, log)
+    progress.update(dict(record, status="hung", reason="no result after 80 s; worker killed"))
+    progress.update(dict(record, run=1, solved=False, time=2.0))
+    assert log.getvalue().splitlines() == [
+        "[1/2] s prm #0 (seed 1): hung: no result after 80 s; worker killed",
+        "[2/2] s prm #1 (seed 1): unsolved in 2.00 s, 7 FCL queries",
+    ]

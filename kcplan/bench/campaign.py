@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import shutil
 import signal
 import subprocess
 import sys
@@ -323,7 +324,8 @@ class Progress:
                 f"\r[{self.done}/{self.total}] {_clock(elapsed)} elapsed, ~{_clock(left)} left"
                 f" | {what}"
             )
-            self.stream.write(line[:160].ljust(160))
+            width = shutil.get_terminal_size((120, 24)).columns - 1
+            self.stream.write(line[: width + 1].ljust(width + 1))
             if self.done == self.total:
                 self.stream.write("\n")
         else:
