@@ -39,7 +39,10 @@ __all__ = [
     "LocalExecutor",
     "DaskExecutor",
     "Progress",
+    "describe_run",
+    "read_records",
     "run_campaign",
+    "ordered",
     "WORKER_COMMAND",
 ]
 
@@ -112,7 +115,9 @@ def campaign_metadata(
     from kcplan.planning.names import PLANNER_NAMES
     from kcplan.planning.problem import PLANNERS
 
-    assert set(planners) <= set(PLANNER_NAMES)
+    unknown = sorted(set(planners) - set(PLANNER_NAMES))
+    if unknown:
+        raise ValueError(f"planners: expected names from {PLANNER_NAMES}, got {unknown}")
     return {
         "started": datetime.now().isoformat(timespec="seconds"),
         "command": command,
