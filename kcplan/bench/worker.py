@@ -34,14 +34,16 @@ def execute(spec: dict) -> dict:
     from kcplan.world import CollisionWorld, load_scenario
 
     scenario = load_scenario(spec["scenario"])
+    world = CollisionWorld(scenario)  # plan() resets its counters and copies them out
     result = plan(
         scenario,
         spec["planner"],
         float(spec["time_limit"]),
         seed=int(spec["seed"]),
         simplify=bool(spec.get("simplify", True)),
+        world=world,
     )
-    check = verify_path(CollisionWorld(scenario), result.states) if result.solved else None
+    check = verify_path(world, result.states) if result.solved else None
     return {
         "status": "ok",
         "reason": "",

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kcplan.geometry.rotations import exp_rotation
 from kcplan.maps import MapImportError
 from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.world.mesh import write_stl
@@ -114,22 +115,6 @@ def _axis_angle_quaternion(axis: np.ndarray, angle: float) -> list[float]:
     return [float(k[0] * s), float(k[1] * s), float(k[2] * s), math.cos(angle / 2.0)]
 
 
-def _rotation_2d(theta: float) -> np.ndarray:
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
-
-
-def _rotation_3d(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z, w = _axis_angle_quaternion(axis, angle)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def _round(values) -> list[float]:
     return [round(float(v), 9) for v in np.ravel(values)]
 
@@ -205,7 +190,7 @@ def _import_2d(folder: Path, name: str, inflation: float) -> dict:
             continue
         bp = bounding_polytopes([a, b], e, OBSTACLE_NORMALS)
         worst = max(worst, bp.error)
-        world = (1 + ROUNDING_MARGIN) * bp.outer @ _rotation_2d(theta).T + [cx, cy]
+        world = (1 + ROUNDING_MARGIN) * bp.outer @ exp_rotation([theta], 2).T + [cx, cy]
         obstacles.append({"polygon": {"vertices": [_round(v) for v in world]}})
     walls, arena_error, low, high = _arena_walls_2d(arena, float(semi_axes.max()))
     description = (
@@ -238,7 +223,7 @@ def _arena_walls_2d(arena: np.ndarray, robot_size: float):
     bp = bounding_polytopes([a, b], e, ARENA_NORMALS_2D)
     ring = (1 - ROUNDING_MARGIN) * bp.inner  # counter-clockwise, centred at the origin
     reach = (max(a, b) + 2.0 * robot_size) / min(np.linalg.norm(ring, axis=1))
-    R, c = _rotation_2d(theta), np.array([cx, cy])
+    R, c = exp_rotation([theta], 2), np.array([cx, cy])
     walls = []
     for p, q in zip(ring, np.roll(ring, -1, axis=0), strict=True):
         quad = np.array([p, reach * p, reach * q, q]) @ R.T + c
