@@ -18,11 +18,14 @@ _COLORS = {
     "kc-prm": "#d62728",
     "prm": "#ff9896",
     "kc-rrtconnect-discrete": "#2ca02c",
+    "rrtconnect-fine": "#ff7f0e",
+    "prm-fine": "#9467bd",
 }
 
 
 def _color(planner: str, i: int) -> str:
-    return _COLORS.get(planner, plt.cm.tab10(i % 10))
+    # planners without a colour of their own: tab10's cyan, olive, grey and pink (unused above)
+    return _COLORS.get(planner, plt.cm.tab10(9 - i % 4))
 
 
 def _planners(records: Sequence[dict]) -> list[str]:
