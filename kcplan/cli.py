@@ -178,7 +178,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 def path_guards(scenario, states) -> list:
     """The guards (pose, inflation) that certify each edge of a path, for plotting."""
-    from kcplan.planning.certificate import EdgeCertifier
+    from kcplan.planning.certifier import EdgeCertifier
     from kcplan.world import CollisionWorld
 
     certifier = EdgeCertifier(CollisionWorld(scenario))

@@ -162,15 +162,29 @@ class Edge:
         2 or 3.
     """
 
-    __slots__ = ("n", "t1", "dt", "yaw1", "w", "q1", "axis", "angle")
+    __slots__ = (
+        "n",
+        "t1",
+        "dt",
+        "yaw1",
+        "w",
+        "q1",
+        "axis",
+        "angle",
+        "translation_speed",
+        "rotation_speed",
+    )
 
     def __init__(self, pose1: ArrayLike, pose2: ArrayLike, n: int):
         p1, p2 = np.asarray(pose1, dtype=float), np.asarray(pose2, dtype=float)
         self.n = n
         self.t1, self.dt = p1[:n], p2[:n] - p1[:n]
+        self.translation_speed = math.sqrt(float(self.dt @ self.dt))  # |t2 - t1| per unit s
         if n == 2:
             self.yaw1 = float(p1[2])
-            self.w = np.array([so2_difference(p1[2], p2[2])])
+            turn = so2_difference(p1[2], p2[2])
+            self.w = np.array([turn])
+            self.rotation_speed = abs(turn)  # radians per unit s
             return
         # plain floats: numpy costs microseconds per call on 4-vectors
         a1, b1, c1, d1 = (float(v) for v in p1[3:])
@@ -187,12 +201,13 @@ class Edge:
         self.angle = 2.0 * math.atan2(norm, rw)
         self.axis = (rx / norm, ry / norm, rz / norm) if norm > 0.0 else (1.0, 0.0, 0.0)
         self.w = np.array(self.axis) * self.angle
+        self.rotation_speed = abs(self.angle)
 
     def sweep_speed(self, radius: float) -> float:
         """Bound on how fast any point within ``radius`` of the robot's centre moves, per
         unit ``s``: ``|t2 - t1| + radius * |w12|`` (a rotation by angle ``phi`` moves such
         a point by a chord at most ``radius * phi``)."""
-        return math.hypot(*self.dt) + radius * math.hypot(*self.w)
+        return self.translation_speed + radius * self.rotation_speed
 
     def pose(self, s: float) -> NDArray[np.float64]:
         """The pose ``q(s)``."""

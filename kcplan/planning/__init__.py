@@ -1,10 +1,21 @@
-"""Planning with OMPL: the KC motion validator, edge certificates, planners, verification.
+"""Planning with OMPL: the motion validator, edge certificates, planners, verification.
 
-:mod:`.certificate` and :mod:`.verify` do not import OMPL; :mod:`.validator`,
-:mod:`.states` and :mod:`.problem` are the thin OMPL adapters.
+:mod:`.guard`, :mod:`.certificates`, :mod:`.certifier`, :mod:`.ladder` and :mod:`.verify`
+do not import OMPL; :mod:`.validator`, :mod:`.states` and :mod:`.problem` are the thin
+OMPL adapters.
 """
 
-from kcplan.planning.certificate import DEFAULT_LADDER, EdgeCertifier, GuardLadder
+from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.guard import Guard, GuardCache
+from kcplan.planning.ladder import DEFAULT_LADDER, GuardLadder
 from kcplan.planning.validator import KCMotionValidator
 
-__all__ = ["DEFAULT_LADDER", "EdgeCertifier", "GuardLadder", "KCMotionValidator"]
+__all__ = [
+    "CERTIFICATE_SETS",
+    "DEFAULT_LADDER",
+    "EdgeCertifier",
+    "Guard",
+    "GuardCache",
+    "GuardLadder",
+    "KCMotionValidator",
+]

@@ -3,6 +3,10 @@
 PLANNER_NAMES = (
     "kc-rrtconnect",
     "kc-prm",
+    "ca-rrtconnect",
+    "ca-prm",
+    "kc-rrtconnect-paper",
+    "kc-prm-paper",
     "kc-rrtconnect-discrete",
     "rrtconnect",
     "prm",

@@ -14,6 +14,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.names import PLANNER_NAMES
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
@@ -25,53 +26,78 @@ __all__ = ["PLANNERS", "PlannerSpec", "PlanResult", "plan", "seed_ompl"]
 
 @dataclass(frozen=True)
 class PlannerSpec:
-    """A registered planner: OMPL class, whether it uses the KC validator, and why."""
+    """A registered planner: the OMPL class and the motion validator's certificates.
+
+    ``certificates`` is None for a stock planner (OMPL's discrete validator at
+    ``resolution``, OMPL's default when None); otherwise the names the
+    :class:`KCMotionValidator` uses (:data:`CERTIFICATE_SETS`).
+    """
 
     make: type
-    kc: bool
+    certificates: tuple[str, ...] | None = None
     fallback: str = "bisection"
     description: str = ""
     resolution: float | None = None  # OMPL's state validity checking resolution (stock)
 
+    @property
+    def kc(self) -> bool:
+        """Whether the planner's edges are certified (a :class:`KCMotionValidator`)."""
+        return self.certificates is not None
 
+
+_KC, _CA, _PAPER = CERTIFICATE_SETS["kc"], CERTIFICATE_SETS["ca"], CERTIFICATE_SETS["kc-paper"]
 PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
-        True,
-        description="stock RRT-Connect, edges certified by KC guards "
-        "(exact fallback); OMPL's default range (0.2 x the space's maximum extent)",
+        _KC,
+        description="stock RRT-Connect, edges certified by free-region planes and KC "
+        "polytopes (exact); OMPL's default range (0.2 x the space's maximum extent)",
     ),
     "kc-prm": PlannerSpec(
-        og.PRM, True, description="stock PRM, roadmap edges certified by KC guards (exact fallback)"
+        og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
+    ),
+    "ca-rrtconnect": PlannerSpec(
+        og.RRTConnect,
+        _CA,
+        description="ablation: kc-rrtconnect with the plain clearance ball only "
+        "(classic conservative advancement)",
+    ),
+    "ca-prm": PlannerSpec(og.PRM, _CA, description="ablation: kc-prm with the clearance ball only"),
+    "kc-rrtconnect-paper": PlannerSpec(
+        og.RRTConnect,
+        _PAPER,
+        description="ablation: kc-rrtconnect with the paper's KC polytope only",
+    ),
+    "kc-prm-paper": PlannerSpec(
+        og.PRM, _PAPER, description="ablation: kc-prm with the paper's KC polytope only"
     ),
     "kc-rrtconnect-discrete": PlannerSpec(
         og.RRTConnect,
-        True,
+        _KC,
         "discrete",
-        "RRT-Connect with one midpoint guard, then OMPL-"
-        "style sampling (the design card's plain variant; not exact)",
+        "RRT-Connect with endpoint guards, then OMPL-style sampling (the design card's "
+        "plain variant; not exact)",
     ),
-    "rrtconnect": PlannerSpec(og.RRTConnect, False, description="stock RRT-Connect"),
-    "prm": PlannerSpec(og.PRM, False, description="stock PRM"),
+    "rrtconnect": PlannerSpec(og.RRTConnect, description="stock RRT-Connect"),
+    "prm": PlannerSpec(og.PRM, description="stock PRM"),
     "rrtconnect-fine": PlannerSpec(
         og.RRTConnect,
-        False,
         description="stock RRT-Connect, discrete validator at 0.1 % of the extent "
         "(10 times finer than OMPL's default; safer, still not exact)",
         resolution=0.001,
     ),
     "prm-fine": PlannerSpec(
         og.PRM,
-        False,
         description="stock PRM, discrete validator at 0.1 % of the extent",
         resolution=0.001,
     ),
-    "rrt": PlannerSpec(og.RRT, False, description="stock RRT"),
-    "rrtstar": PlannerSpec(og.RRTstar, False, description="stock RRT* (runs to the time limit)"),
-    "bitstar": PlannerSpec(og.BITstar, False, description="stock BIT* (runs to the time limit)"),
+    "rrt": PlannerSpec(og.RRT, description="stock RRT"),
+    "rrtstar": PlannerSpec(og.RRTstar, description="stock RRT* (runs to the time limit)"),
+    "bitstar": PlannerSpec(og.BITstar, description="stock BIT* (runs to the time limit)"),
 }
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
-default discrete motion validator at the default resolution (1 % of the space extent)."""
+default discrete motion validator at the default resolution (1 % of the space extent).
+The ``kc-*``, ``ca-*`` and ``kc-*-paper`` planners differ only in their certificates."""
 if tuple(PLANNERS) != PLANNER_NAMES:  # pragma: no cover - keeps the CLI's list honest
     raise ImportError("kcplan.planning.names.PLANNER_NAMES is out of date")
 
@@ -167,18 +193,25 @@ def plan(
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     checker_calls = [0]
+    validator = None
+    if spec.kc:
+        validator = KCMotionValidator(
+            si, scenario.semi_axes, world, spec.certificates, spec.fallback
+        )
+        si.setMotionValidator(validator)
+        state_valid = validator.state_valid  # shares the validator's guard cache
+    else:
+
+        def state_valid(state) -> bool:
+            return not world.in_collision(state_pose(state, n))
 
     def is_valid(state) -> bool:
         checker_calls[0] += 1
-        return not world.in_collision(state_pose(state, n))
+        return state_valid(state)
 
     si.setStateValidityChecker(is_valid)
     if spec.resolution is not None:
         si.setStateValidityCheckingResolution(spec.resolution)
-    validator = None
-    if spec.kc:
-        validator = KCMotionValidator(si, scenario.semi_axes, world, spec.fallback)
-        si.setMotionValidator(validator)
     start, goal = si.allocState(), si.allocState()
     set_state(start, scenario.start, n)
     set_state(goal, scenario.goal, n)
@@ -202,7 +235,9 @@ def plan(
             del path
         counters = {
             **world.counters,
-            "fcl_queries": world.counters["collision_queries"] + world.counters["distance_queries"],
+            "fcl_queries": world.counters["collision_queries"]
+            + world.counters["distance_queries"]
+            + world.counters["region_queries"],
             "checker_calls": checker_calls[0],
         }
         if validator is not None:

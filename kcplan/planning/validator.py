@@ -18,23 +18,26 @@ Contract (OMPL's, as far as the Python binding allows):
   so planners that use it (the KPIECE family) treat a rejected edge as wholly invalid;
   none of kcplan's registered planners uses that form.
 * OMPL's own motion counters stay at zero for a Python validator; :attr:`counters` has
-  kcplan's (see :class:`kcplan.planning.certificate.EdgeCertifier`).
+  kcplan's (see :class:`kcplan.planning.certifier.EdgeCertifier`).
 * Not thread-safe; OMPL calls it from the thread that runs ``solve()``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
-from kcplan.planning.certificate import EdgeCertifier, GuardLadder
+from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import state_pose
 
 __all__ = ["KCMotionValidator"]
 
 
 class KCMotionValidator(ob.MotionValidator):
-    """Certify OMPL edges with KC guards (see the module docstring for the contract).
+    """Certify OMPL edges with guards and certificates (see the module docstring).
 
     Parameters
     ----------
@@ -44,15 +47,26 @@ class KCMotionValidator(ob.MotionValidator):
         The robot's semi-axes, in the state space's length unit.
     world : object
         ``in_collision(pose) -> bool`` and ``safe_clearance(pose) -> float`` for flat
-        poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``, e.g.
+        poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``; ``free_region`` for the
+        ``region`` certificate and ``sweep_core_collides`` for ``sweep_test``, e.g.
         :class:`kcplan.world.CollisionWorld`.
+    certificates : sequence of str
+        Default ``("region", "polytope")``; see
+        :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
     fallback : {"bisection", "discrete"}
-        What to do with an edge the midpoint guard does not cover: more guards (exact,
-        the default) or OMPL-style sampling at the space's validity-checking resolution.
+        What to do with the part of an edge the endpoint guards do not cover: more
+        guards (exact, the default) or OMPL-style sampling at the space's
+        validity-checking resolution.
     inflations : sequence of float, optional
-        Guard inflation ladder (default :data:`kcplan.planning.certificate.DEFAULT_LADDER`).
+        Guard inflation ladder of the ``polytope`` certificate (default
+        :data:`kcplan.planning.ladder.DEFAULT_LADDER`).
+    horizon : float, optional
+        Region horizon in length units (default ``max(a)``).
     max_guards : int
         Guards per edge before giving up ("not proven" rejects the edge).
+    sweep_test : bool
+        Reject an edge whose robot core (ball of radius ``min(a)``) sweeps into an
+        obstacle with one collision query before measuring guards.
     """
 
     def __init__(
@@ -60,22 +74,41 @@ class KCMotionValidator(ob.MotionValidator):
         si: ob.SpaceInformation,
         semi_axes: ArrayLike,
         world,
+        certificates: Sequence[str] = CERTIFICATE_SETS["kc"],
         fallback: str = "bisection",
-        inflations=None,
-        max_guards: int = 256,
+        inflations: Sequence[float] | None = None,
+        horizon: float | None = None,
+        max_guards: int = 64,
+        sweep_test: bool = True,
     ):
         super().__init__(si)
         self.si = si
         self.space = si.getStateSpace()
-        ladder = GuardLadder(semi_axes, inflations)
-        self.certifier = EdgeCertifier(world, semi_axes, ladder, fallback, max_guards)
+        ladder = GuardLadder(semi_axes, inflations) if "polytope" in certificates else None
+        self.certifier = EdgeCertifier(
+            world,
+            semi_axes,
+            certificates,
+            ladder,
+            horizon,
+            fallback,
+            max_guards,
+            sweep_test,
+        )
         self.n = self.certifier.n
 
     @property
     def counters(self) -> dict:
-        """kcplan's counters: edges, certified_one_guard, guards, bisection_nodes,
-        collision_queries, rejected, rejected_end_state, not_proven."""
-        return self.certifier.counters
+        """kcplan's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`) and, as
+        ``covered_NAME``, the edge parameter each certificate covered."""
+        return self.certifier.counters | {
+            f"covered_{k}": round(v, 6) for k, v in self.certifier.covered.items()
+        }
+
+    def state_valid(self, state) -> bool:
+        """A state validity check that shares the validator's cache: use it as the
+        setup's checker so that edges ending at checked states skip that query."""
+        return self.certifier.state_valid(state_pose(state, self.n))
 
     def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
         resolution = 0.01

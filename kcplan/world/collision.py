@@ -27,12 +27,16 @@ would be missed.
 
 from __future__ import annotations
 
+import math
+
 import fcl
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kcplan.geometry.pose import pose_size
+from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario
+from kcplan.world.support import box_vertices, piece_supports
 
 __all__ = ["CLEARANCE_RTOL", "CLEARANCE_ATOL", "CollisionWorld"]
 
@@ -63,13 +67,8 @@ def _prism(polygon: NDArray, half_height: float) -> fcl.Convex:
     return fcl.Convex(V, k + 2, np.array(faces, dtype=np.int32))
 
 
-def _box_corners(ob: Obstacle) -> NDArray:
-    signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
-    return ob.center + (signs * ob.extents) @ ob.rotation.T
-
-
 def _box3(ob: Obstacle) -> fcl.Convex:
-    V = _box_corners(ob)  # index = 4 i + 2 j + k for signs (i, j, k)
+    V = box_vertices(ob.center, ob.rotation, ob.extents)  # index = 4 i + 2 j + k for signs (i, j, k)
     quads = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
     faces = np.array([x for q in quads for x in (4, *q)], dtype=np.int32)
     return fcl.Convex(V, 6, faces)
@@ -118,9 +117,15 @@ class CollisionWorld:
         self._half_height = float(max(a.max(), 1.0))
         self._objects: list[fcl.CollisionObject] = []
         self.owner: list[int] = []  # obstacle index of each FCL object
+        self._supports: list = []  # exact support function of each FCL object, or None
+        self._piece_of: dict[int, int] = {}  # id of an FCL geometry -> its object's index
         for ob in scenario.obstacles:
-            for geom, tf in self._fcl_parts(ob):
+            parts = self._fcl_parts(ob)
+            supports = piece_supports(ob)
+            for (geom, tf), support in zip(parts, supports, strict=True):
+                self._piece_of[id(geom)] = len(self._objects)
                 self._objects.append(fcl.CollisionObject(geom, tf))
+                self._supports.append(support)
                 self.owner.append(ob.index)
         self._manager = fcl.DynamicAABBTreeCollisionManager()
         if self._objects:
@@ -130,7 +135,15 @@ class CollisionWorld:
         self.clearance_atol = CLEARANCE_ATOL * float(
             max(np.ptp(scenario.bounds, axis=0).max(), a.max())
         )
-        self.counters = {"collision_queries": 0, "distance_queries": 0}
+        self._reach = float(a.max())  # the robot lies within this distance of its centre
+        self._horizon_boxes: dict[float, fcl.CollisionObject] = {}
+        self._pair_request = fcl.DistanceRequest(enable_nearest_points=True)
+        self.counters = {
+            "collision_queries": 0,
+            "distance_queries": 0,
+            "region_queries": 0,
+            "region_pairs": 0,
+        }
 
     def _fcl_parts(self, ob: Obstacle) -> list[tuple]:
         n, identity = self.dimension, fcl.Transform()
@@ -208,6 +221,82 @@ class CollisionWorld:
         CLEARANCE_ATOL * scene size`` (one FCL query)."""
         d = self.clearance(pose)
         return max(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+
+    def free_region(self, pose: ArrayLike, horizon: float) -> FreeRegion:
+        """Separating planes and clearances of every obstacle piece within ``horizon`` of
+        the robot at ``pose`` (one region query: a broad-phase query, then one
+        narrow-phase distance per piece found; see :mod:`kcplan.world.region`).
+
+        Pieces are found by their FCL bounding boxes overlapping the cube of half side
+        ``max(a) + horizon`` around the robot's centre, which contains every point within
+        ``horizon`` of the robot; a piece outside it is therefore at least ``horizon``
+        away. Returns :meth:`FreeRegion.colliding` as soon as a piece touches the robot.
+        """
+        n = self.dimension
+        self._place(pose)
+        self.counters["region_queries"] += 1
+        horizon = float(horizon)
+        if not self._objects:
+            return FreeRegion.empty(n, math.inf)
+        box = self._horizon_boxes.get(horizon)
+        if box is None:
+            side = 2.0 * (self._reach + horizon)
+            height = side if n == 3 else 4.0 * self._half_height  # 2D: cover every prism
+            box = fcl.CollisionObject(fcl.Box(side, side, height), fcl.Transform())
+            self._horizon_boxes[horizon] = box
+        p = np.asarray(pose, dtype=float)
+        box.setTranslation(p[:3] if n == 3 else np.array([p[0], p[1], 0.0]))
+        near: list[fcl.CollisionObject] = []
+        self._manager.collide(box, None, lambda o1, _o2, _data: near.append(o1) or False)
+        self.counters["region_pairs"] += len(near)
+        k = len(near)
+        normals, offsets, clearances = np.zeros((k, n)), np.full(k, math.inf), np.empty(k)
+        robot, request, rtol = self._robot, self._pair_request, 1.0 - CLEARANCE_RTOL
+        for i, obstacle in enumerate(near):
+            result = fcl.DistanceResult()
+            d = fcl.distance(robot, obstacle, request, result)
+            if d <= 0.0:
+                return FreeRegion.colliding(n)
+            clearances[i] = max(d * rtol - self.clearance_atol, 0.0)
+            support = self._supports[self._piece_of[id(result.o2)]]
+            if support is None:
+                continue
+            p_robot, p_obstacle = result.nearest_points
+            direction = (p_robot - p_obstacle)[:n]
+            length = math.sqrt(float(direction @ direction))
+            if length > 0.0:
+                normals[i] = direction / length
+                offsets[i] = support(normals[i])
+        return FreeRegion(normals, offsets, clearances, horizon)
+
+    def sweep_core_collides(self, t1: ArrayLike, t2: ArrayLike, radius: float) -> bool:
+        """Whether the capsule of ``radius`` around the segment ``t1 -> t2`` (centre
+        positions) meets an obstacle (one FCL collision query).
+
+        The robot contains the ball of radius ``min(a)`` about its centre in every
+        orientation, so when the robot's centre moves along the segment with that
+        radius, a hit proves that the motion collides; it never proves a motion free.
+        """
+        n = self.dimension
+        t1 = np.asarray(t1, dtype=float)[:n]
+        t2 = np.asarray(t2, dtype=float)[:n]
+        self.counters["collision_queries"] += 1
+        if not self._objects:
+            return False
+        axis = np.zeros(3)
+        axis[:n] = t2 - t1
+        length = float(np.linalg.norm(axis))
+        centre = np.zeros(3)
+        centre[:n] = 0.5 * (t1 + t2)
+        # rotate the capsule's z axis onto the segment: half-way quaternion [w, x, y, z]
+        z = axis / length if length > 0.0 else np.array([0.0, 0.0, 1.0])
+        q = np.array([1.0 + z[2], -z[1], z[0], 0.0])
+        norm = float(np.linalg.norm(q))
+        q = q / norm if norm > 1e-12 else np.array([0.0, 1.0, 0.0, 0.0])
+        capsule = fcl.CollisionObject(fcl.Capsule(float(radius), length), fcl.Transform(q, centre))
+        data = fcl.CollisionData()
+        self._manager.collide(capsule, data, fcl.defaultCollisionCallback)
+        return bool(data.result.is_collision)
 
     def in_collision_many(self, poses: ArrayLike) -> NDArray[np.bool_]:
         """:meth:`in_collision` for each row of ``poses`` (shape ``(k, 3 or 7)``)."""

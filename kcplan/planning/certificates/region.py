@@ -1,0 +1,75 @@
+"""The free-region certificate: the robot moving inside a convex free region.
+
+This is the Kinematics of Containment with the larger body being the free space itself.
+A region guard lists every obstacle piece within a horizon ``H`` of the robot at
+``q(m)`` (:meth:`kcplan.world.CollisionWorld.free_region`): for a convex piece ``i`` a
+plane ``n_i . x <= c_i`` that contains the piece (its exact support function), with the
+robot's slack ``sigma_i(m) = n_i . t(m) - |A R(m)^T n_i| - c_i > 0``
+(:meth:`kcplan.planning.guard.Guard.from_region`), and the robot's clearance ``d_i`` to it.
+
+Along the edge ``t(s) = t(m) + (s - m) dt`` exactly, and ``|A R(s)^T n|`` changes by at
+most ``L |s - m| |w|`` with ``L = max(a) - min(a)`` (proof in
+:mod:`kcplan.planning.certificates.ball`), so
+
+    sigma_i(s) >= sigma_i(m) + (s - m) (n_i . dt) - |s - m| L |w|,
+
+linear in ``|s - m|`` on each side: piece ``i`` stays on its side of the plane for
+``s - m < sigma_i / (L |w| - n_i . dt)`` (forever when the edge moves away from the plane
+faster than it turns), and for ``|s - m| <= d_i / (|dt| + L |w|)`` by its clearance
+ball. Either proof suffices for that piece; pieces beyond the horizon are at least ``H``
+away, covered by the ball of radius ``H``. The reach is the minimum over pieces. Motion
+along a wall is free: only rotation and motion towards a plane use up its slack.
+Non-convex pieces (meshes) have no plane and keep their clearance ball.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from kcplan.geometry.pose import Edge
+from kcplan.planning.guard import Guard
+
+__all__ = ["FreeRegionPlanes"]
+
+
+class FreeRegionPlanes:
+    """Separating planes and clearances of the pieces within a guard's horizon.
+
+    Parameters
+    ----------
+    semi_axes : array_like, shape (n,)
+    """
+
+    name = "region"
+
+    def __init__(self, semi_axes: ArrayLike):
+        a = [float(v) for v in semi_axes]
+        self.lever = max(a) - min(a)
+
+    def reach(self, guard: Guard, edge: Edge, m: float) -> tuple[float, float]:
+        turn = self.lever * edge.rotation_speed
+        speed = edge.translation_speed + turn
+        if speed <= 0.0:
+            return math.inf, math.inf
+        far = guard.horizon / speed
+        if not len(guard.slacks):
+            return far, far
+        along = guard.normals @ edge.dt
+        ball = guard.clearances / speed
+        slack = guard.slacks
+        return (
+            min(far, float(np.maximum(_plane_reach(slack, turn + along), ball).min())),
+            min(far, float(np.maximum(_plane_reach(slack, turn - along), ball).min())),
+        )
+
+
+def _plane_reach(slack: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """``slack / rate`` where the slack is used up (``rate > 0``), ``inf`` where it is
+    not, 0 where there is no positive slack to begin with."""
+    positive = slack > 0.0
+    out = np.where(positive, math.inf, 0.0)
+    np.divide(slack, rate, out=out, where=positive & (rate > 0.0))
+    return out

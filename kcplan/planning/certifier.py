@@ -1,0 +1,294 @@
+"""The edge certifier: where certificates, guards, the guard cache and rejection meet.
+
+This module holds the one piece of logic that combines certificates
+(:mod:`kcplan.planning.certificates`) into a decision about an OMPL edge; it does not
+import OMPL (:class:`kcplan.planning.validator.KCMotionValidator` is the thin adapter).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from kcplan.geometry.pose import Edge
+from kcplan.planning.certificates import (
+    CERTIFICATE_NAMES,
+    ClearanceBall,
+    FreeRegionPlanes,
+    KCPolytope,
+)
+from kcplan.planning.guard import Guard, GuardCache
+from kcplan.planning.ladder import GuardLadder
+
+__all__ = ["CERTIFICATE_SETS", "EdgeCertifier"]
+
+CERTIFICATE_SETS = {
+    "ca": ("ball",),
+    "kc-paper": ("polytope",),
+    "kc": ("region", "polytope"),
+}
+"""The certificate sets of the ablation planners (``ca-*``, ``kc-*-paper``, ``kc-*``).
+``region`` includes a rotation-aware clearance ball per obstacle piece, so ``rotation``
+adds nothing to it."""
+
+COUNTER_NAMES = (
+    "edges",
+    "rejected",
+    "rejected_end_state",
+    "rejected_sweep",
+    "rejected_guard",
+    "not_proven",
+    "certified_by_endpoints",
+    "certified_one_guard",
+    "guards",
+    "endpoint_guards",
+    "cached_guards",
+    "bisection_nodes",
+    "collision_queries",
+)
+
+
+class EdgeCertifier:
+    """Prove edges collision-free with guards and certificates, or reject them.
+
+    ``check(p1, p2)`` follows OMPL's ``MotionValidator`` contract: ``p1`` is assumed
+    valid, ``p2`` is not. The edge is decided as follows, each step only when the
+    previous ones leave part of it open:
+
+    1. ``p2``: skipped when the cache knows it valid, else one collision query, and a
+       colliding ``p2`` rejects the edge.
+    2. Endpoint guards from the cache cover ``[0, lo]`` (guard at ``p1``) and
+       ``[hi, 1]`` (guard at ``p2``); ``lo >= hi`` certifies the edge with no query.
+    3. Cheap rejection (``sweep_test``): the robot contains the ball of radius
+       ``min(a)`` about its centre, so if the capsule swept by that ball over
+       ``[lo, hi]`` meets an obstacle (one collision query), the edge collides.
+    4. Missing endpoint guards are measured and cached (a state the planner keeps is
+       never queried twice).
+    5. Advancement: a guard at the middle of each open stretch, removing what it covers,
+       until nothing is open (certified), a guard touches an obstacle or cannot make
+       progress (rejected), or ``max_guards`` guards were placed ("not proven", rejected).
+
+    Every guard is measured once (a clearance query, or a region query when the
+    ``region`` certificate is on) and every certificate reports its reach from it; the
+    largest reach on each side wins (the certificates' union is an interval around the
+    guard). ``covered`` sums, per certificate, the stretches of edge parameter it won.
+
+    With ``fallback="discrete"`` the stretch left open after step 4 is sampled at
+    ``resolution`` (in units of ``s``) with collision queries, as OMPL's discrete
+    validator does; that mode is not exact.
+
+    Parameters
+    ----------
+    world : object
+        ``in_collision(pose)``, ``safe_clearance(pose)``; for ``region`` also
+        ``free_region(pose, horizon)`` and ``clearance_atol``; for ``sweep_test``
+        ``sweep_core_collides(t1, t2, radius)``: :class:`kcplan.world.CollisionWorld`.
+    semi_axes : array_like, shape (n,), optional
+        Default ``world.semi_axes``.
+    certificates : sequence of str
+        Names from :data:`kcplan.planning.certificates.CERTIFICATE_NAMES`.
+    ladder : GuardLadder, optional
+        For ``polytope``; built on demand.
+    horizon : float, optional
+        Region horizon ``H`` in length units; default ``max(a)``.
+    fallback : {"bisection", "discrete"}
+    max_guards : int
+        Guards per edge after the endpoints before "not proven".
+    sweep_test : bool
+        Step 3.
+    cache : GuardCache, optional
+        Shared with the state validity checker (see :meth:`state_valid`).
+
+    Not thread-safe (the world reuses one FCL robot object).
+    """
+
+    def __init__(
+        self,
+        world,
+        semi_axes: ArrayLike | None = None,
+        certificates: Sequence[str] = CERTIFICATE_SETS["kc"],
+        ladder: GuardLadder | None = None,
+        horizon: float | None = None,
+        fallback: str = "bisection",
+        max_guards: int = 64,
+        sweep_test: bool = True,
+        cache: GuardCache | None = None,
+    ):
+        if fallback not in ("bisection", "discrete"):
+            raise ValueError(f"fallback: expected 'bisection' or 'discrete', got {fallback!r}")
+        unknown = [c for c in certificates if c not in CERTIFICATE_NAMES]
+        if unknown or not certificates:
+            raise ValueError(
+                f"certificates: expected names from {', '.join(CERTIFICATE_NAMES)}, "
+                f"got {list(certificates)}"
+            )
+        self.world = world
+        a = np.asarray(world.semi_axes if semi_axes is None else semi_axes, dtype=float)
+        self.semi_axes, self.n = a, len(a)
+        self.core_radius = float(a.min())
+        self.certificates = []
+        for name in certificates:
+            if name in ("ball", "rotation"):
+                self.certificates.append(ClearanceBall(a, rotation_aware=name == "rotation"))
+            elif name == "polytope":
+                self.certificates.append(KCPolytope(ladder or GuardLadder(a)))
+            else:
+                self.certificates.append(FreeRegionPlanes(a))
+        self.use_region = "region" in certificates
+        self.horizon = float(a.max() if horizon is None else horizon)
+        self.margin = float(getattr(world, "clearance_atol", 0.0)) + 1e-12 * float(a.max())
+        self.fallback = fallback
+        self.max_guards = int(max_guards)
+        self.sweep_test = bool(sweep_test)
+        self.cache = cache if cache is not None else GuardCache()
+        self.counters = dict.fromkeys(COUNTER_NAMES, 0)
+        self.covered = dict.fromkeys((c.name for c in self.certificates), 0.0)
+        self.guard_log: list[tuple[np.ndarray, float]] | None = None  # (pose, eps) if enabled
+
+    @property
+    def ladder(self) -> GuardLadder | None:
+        """The polytope ladder, when the ``polytope`` certificate is on."""
+        for c in self.certificates:
+            if isinstance(c, KCPolytope):
+                return c.ladder
+        return None
+
+    def measure(self, pose: np.ndarray) -> Guard:
+        """One guard query at ``pose`` (not cached)."""
+        self.counters["guards"] += 1
+        if self.use_region:
+            region = self.world.free_region(pose, self.horizon)
+            guard = Guard.from_region(pose, region, self.semi_axes, self.margin)
+        else:
+            guard = Guard(pose, self.world.safe_clearance(pose))
+        if self.guard_log is not None and guard.clearance > 0.0:
+            self.guard_log.append((pose, guard.clearance / float(self.semi_axes.max())))
+        return guard
+
+    def state_valid(self, pose: ArrayLike) -> bool:
+        """State validity with the cache: one collision query for a pose not seen before,
+        remembered so that a later edge ending there skips its end-state query."""
+        p = np.asarray(pose, dtype=float)
+        key = p.tobytes()
+        known = self.cache.validity(key)
+        if known is not None:
+            return known
+        self.counters["collision_queries"] += 1
+        valid = not self.world.in_collision(p)
+        self.cache.add_validity(key, valid)
+        return valid
+
+    def _endpoint(self, pose: np.ndarray, key: bytes) -> Guard:
+        guard = self.cache.guard(key)
+        if guard is None:
+            self.counters["endpoint_guards"] += 1
+            guard = self.measure(pose)
+            self.cache.add_guard(key, guard)
+        return guard
+
+    def _reach(self, guard: Guard, edge: Edge, m: float, s0: float, s1: float):
+        """``(lo, hi)`` covered by ``guard`` at ``q(m)``; credits the winning certificates
+        with what they cover of ``[s0, s1]``."""
+        best_minus = best_plus = 0.0
+        win_minus = win_plus = None
+        for certificate in self.certificates:
+            minus, plus = certificate.reach(guard, edge, m)
+            if minus > best_minus:
+                best_minus, win_minus = minus, certificate.name
+            if plus > best_plus:
+                best_plus, win_plus = plus, certificate.name
+        lo, hi = m - best_minus, m + best_plus
+        if win_minus is not None:
+            self.covered[win_minus] += m - max(lo, s0) if m > s0 else 0.0
+        if win_plus is not None:
+            self.covered[win_plus] += min(hi, s1) - m if m < s1 else 0.0
+        return lo, hi
+
+    def _reject(self, reason: str) -> bool:
+        self.counters["rejected"] += 1
+        self.counters[reason] += 1
+        return False
+
+    def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
+        """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs)."""
+        c = self.counters
+        c["edges"] += 1
+        p1 = np.asarray(pose1, dtype=float)
+        p2 = np.asarray(pose2, dtype=float)
+        k1, k2 = p1.tobytes(), p2.tobytes()
+        cache = self.cache
+        g1, g2 = cache.guard(k1), cache.guard(k2)
+        if not self.state_valid(p2):
+            return self._reject("rejected_end_state")
+        edge = Edge(p1, p2, self.n)
+        lo, hi = 0.0, 1.0
+        if g1 is not None:
+            c["cached_guards"] += 1
+            lo = self._reach(g1, edge, 0.0, 0.0, 1.0)[1]
+        if g2 is not None:
+            c["cached_guards"] += 1
+            hi = self._reach(g2, edge, 1.0, 0.0, 1.0)[0]
+        if lo >= hi:
+            c["certified_by_endpoints"] += 1
+            return True
+        if self.sweep_test:
+            c["collision_queries"] += 1
+            if self.world.sweep_core_collides(edge.pose(lo), edge.pose(hi), self.core_radius):
+                return self._reject("rejected_sweep")
+        if g1 is None:
+            g1 = self._endpoint(p1, k1)
+            if g1.clearance <= 0.0:
+                return self._reject("rejected_guard")
+            lo = self._reach(g1, edge, 0.0, 0.0, hi)[1]
+        if lo < hi and g2 is None:
+            g2 = self._endpoint(p2, k2)
+            if g2.clearance <= 0.0:
+                return self._reject("rejected_end_state")
+            hi = self._reach(g2, edge, 1.0, lo, 1.0)[0]
+        if lo >= hi:
+            c["certified_by_endpoints"] += 1
+            return True
+        if self.fallback == "discrete":
+            return self._sample(edge, resolution, lo, hi)
+        return self._advance(edge, lo, hi)
+
+    def _advance(self, edge: Edge, lo: float, hi: float) -> bool:
+        c = self.counters
+        pending = [(lo, hi)]
+        guards = 0
+        while pending:
+            s0, s1 = pending.pop()
+            if guards >= self.max_guards:
+                c["bisection_nodes"] += guards
+                return self._reject("not_proven")
+            m = 0.5 * (s0 + s1)
+            guard = self.measure(edge.pose(m))
+            guards += 1
+            if guard.clearance <= 0.0:
+                c["bisection_nodes"] += guards
+                return self._reject("rejected_guard")
+            g_lo, g_hi = self._reach(guard, edge, m, s0, s1)
+            if g_hi - g_lo <= 1e-12:
+                c["bisection_nodes"] += guards
+                return self._reject("not_proven")
+            if g_lo > s0:
+                pending.append((s0, g_lo))
+            if g_hi < s1:
+                pending.append((g_hi, s1))
+        c["bisection_nodes"] += guards
+        c["certified_one_guard"] += guards == 1
+        return True
+
+    def _sample(self, edge: Edge, resolution: float, lo: float, hi: float) -> bool:
+        steps = max(1, math.ceil(1.0 / resolution))
+        for i in range(1, steps):
+            s = i / steps
+            if s <= lo or s >= hi:
+                continue  # covered by an endpoint guard
+            self.counters["collision_queries"] += 1
+            if self.world.in_collision(edge.pose(s)):
+                return self._reject("rejected_guard")
+        return True

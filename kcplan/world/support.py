@@ -1,0 +1,93 @@
+"""Support functions of convex obstacle pieces: ``h_O(n) = max over x in O of n . x``.
+
+A convex obstacle ``O`` lies in the half-space ``{x : n . x <= h_O(n)}`` for every unit
+direction ``n``, exactly, whatever ``n`` is. The free-region certificate relies on this:
+it takes a direction from FCL's (iterative, approximate) nearest points but the offset of
+the separating plane from here, so an inaccurate direction can only weaken a certificate,
+never make it wrong.
+
+Pieces are world-frame and in the scenario's dimension (2D obstacles are planar: the
+prisms FCL sees are an implementation detail of :mod:`.collision`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["PointsSupport", "BallSupport", "EllipsoidSupport", "box_vertices", "piece_supports"]
+
+
+class PointsSupport:
+    """Convex hull of points (polygon pieces, boxes): ``h(n) = max_i v_i . n``.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (m, n)
+    """
+
+    __slots__ = ("vertices",)
+
+    def __init__(self, vertices: NDArray):
+        self.vertices = np.ascontiguousarray(vertices, dtype=float)
+
+    def __call__(self, direction: NDArray) -> float:
+        return float((self.vertices @ direction).max())
+
+
+class BallSupport:
+    """Disc or ball: ``h(n) = c . n + r |n|``."""
+
+    __slots__ = ("center", "radius")
+
+    def __init__(self, center: NDArray, radius: float):
+        self.center, self.radius = np.asarray(center, dtype=float), float(radius)
+
+    def __call__(self, direction: NDArray) -> float:
+        return float(self.center @ direction) + self.radius * math.sqrt(
+            float(direction @ direction)
+        )
+
+
+class EllipsoidSupport:
+    """Ellipse or ellipsoid ``{c + R diag(e) u : |u| <= 1}``: ``h(n) = c . n + |diag(e) R^T n|``."""
+
+    __slots__ = ("center", "shape")
+
+    def __init__(self, center: NDArray, rotation: NDArray, extents: NDArray):
+        self.center = np.asarray(center, dtype=float)
+        self.shape = np.asarray(extents, dtype=float)[:, None] * np.asarray(rotation).T
+
+    def __call__(self, direction: NDArray) -> float:
+        return float(self.center @ direction) + float(np.linalg.norm(self.shape @ direction))
+
+
+def box_vertices(center: NDArray, rotation: NDArray, extents: NDArray) -> NDArray:
+    """Corners of a box, shape ``(2**n, n)``; corner ``sum_k 2**(n-1-k) [sign_k > 0]`` has
+    the signs of its index's bits (``meshgrid`` order)."""
+    n = len(center)
+    signs = np.array(np.meshgrid(*[[-1.0, 1.0]] * n, indexing="ij")).reshape(n, -1).T
+    return center + (signs * extents) @ rotation.T
+
+
+def piece_supports(obstacle) -> list:
+    """Support functions of an obstacle's convex pieces, in the order
+    :class:`kcplan.world.CollisionWorld` registers them; ``None`` for a piece that is
+    not convex (a mesh: only its clearance can be used).
+
+    Parameters
+    ----------
+    obstacle : kcplan.world.Obstacle
+    """
+    kind, n = obstacle.kind, len(obstacle.center)
+    if kind in ("polygon", "box") and n == 2:
+        return [PointsSupport(p) for p in obstacle.pieces]
+    if kind == "box":
+        return [PointsSupport(box_vertices(obstacle.center, obstacle.rotation, obstacle.extents))]
+    if kind in ("circle", "sphere"):
+        return [BallSupport(obstacle.center, obstacle.extents[0])]
+    if kind in ("ellipse", "ellipsoid"):
+        return [EllipsoidSupport(obstacle.center, obstacle.rotation, obstacle.extents)]
+    return [None]
