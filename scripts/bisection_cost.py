@@ -18,7 +18,7 @@ import argparse
 
 import numpy as np
 
-from kcplan.planning.certificate import EdgeCertifier
+from kcplan.planning.certifier import EdgeCertifier
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
 from kcplan.viz import plt, save_figure

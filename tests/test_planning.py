@@ -15,7 +15,8 @@ from ompl import base as ob
 from kcplan.cli import main
 from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.rotations import log_rotation
-from kcplan.planning.certificate import EdgeCertifier, GuardLadder
+from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
@@ -69,9 +70,15 @@ def random_world(rng, n, a):
     for _ in range(int(rng.integers(2, 7))):
         c = rng.uniform(-20, 20, n).tolist()
         kind = rng.integers(3)
-        if kind == 0:  # thin wall
+        if kind == 0:  # thin wall, rotated
             size = [float(rng.uniform(0.01, 0.2))] + [float(rng.uniform(5, 30))] * (n - 1)
-            obstacles.append({"box": {"center": c, "size": rng.permutation(size).tolist()}})
+            box = {"center": c, "size": rng.permutation(size).tolist()}
+            if n == 2:
+                box["yaw"] = float(rng.uniform(-np.pi, np.pi))
+            else:
+                q = rng.normal(size=4)
+                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
+            obstacles.append({"box": box})
         elif kind == 1:
             key = "circle" if n == 2 else "sphere"
             obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.5, 5))}})
@@ -89,20 +96,26 @@ def random_world(rng, n, a):
     return CollisionWorld(parse_scenario(data, check=False))
 
 
+@pytest.mark.parametrize("certificates", sorted(CERTIFICATE_SETS))
 @pytest.mark.parametrize(
     "n, shapes, edges_per_world",
-    [(2, [[5, 3.5], [1, 0.4], [3, 3], [8, 1]], 40), (3, [[4, 2.5, 2], [1, 1, 0.3]], 25)],
+    [(2, [[5, 3.5], [1, 0.4], [3, 3], [8, 1]], 30), (3, [[4, 2.5, 2], [1, 1, 0.3]], 20)],
 )
-def test_accepted_edges_are_free_and_colliding_edges_rejected(n, shapes, edges_per_world):
-    """Thousands of random edges: accepted => free under gap-free verification;
-    a collision found by dense sampling => rejected."""
+def test_accepted_edges_are_free_and_colliding_edges_rejected(
+    certificates, n, shapes, edges_per_world
+):
+    """Thousands of random edges near thin rotated walls: accepted => free under gap-free
+    verification (clearances only, independent of every certificate) and under dense
+    collision sampling; a collision found by dense sampling => rejected. The reversed
+    edges run between two cached guards, certified with no new guard query."""
     rng = np.random.default_rng(100 + n)
-    accepted = rejected_with_collision = 0
+    accepted = rejected_with_collision = by_cache = 0
     for a in shapes:
         ladder = GuardLadder(a, (0.01, 0.05, 0.2) if n == 3 else None)
-        for _ in range(12 if n == 2 else 10):
+        for _ in range(8 if n == 2 else 6):
             world = random_world(rng, n, a)
-            certifier = EdgeCertifier(world, a, ladder)
+            kinds = CERTIFICATE_SETS[certificates]
+            certifier = EdgeCertifier(world, a, kinds, ladder if "polytope" in kinds else None)
             for _ in range(edges_per_world):
                 p1 = random_pose(rng, n, -22, 22)
                 if world.in_collision(p1):
@@ -117,24 +130,69 @@ def test_accepted_edges_are_free_and_colliding_edges_rejected(n, shapes, edges_p
                     accepted += 1
                     assert not dense.any()
                     assert not verify_path(world, [p1, p2]).collides
+                    guards = certifier.counters["guards"]
+                    if certifier.check(p2, p1):  # both ends cached now
+                        by_cache += certifier.counters["guards"] == guards
+                        assert not verify_path(world, [p2, p1]).collides
                 elif dense.any():
                     rejected_with_collision += 1
-    assert accepted > 100 and rejected_with_collision > (50 if n == 2 else 10)
+    assert accepted > 60 and rejected_with_collision > (30 if n == 2 else 8)
+    assert by_cache > 0
 
 
 def test_counters_add_up():
     s = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
     world = CollisionWorld(s)
-    certifier = EdgeCertifier(world)
+    certifier = EdgeCertifier(world, certificates=("ball",), sweep_test=False, occupancy=False)
     assert certifier.check(s.start, s.start + np.array([3.0, 0.0, 0.1]))
     c = certifier.counters
-    assert c["edges"] == 1 and c["certified_one_guard"] == 1 and c["guards"] == 1
-    assert world.counters == {"collision_queries": 1, "distance_queries": 1}
+    # end-state query, then one endpoint guard at the start covers the whole edge
+    assert c["edges"] == 1 and c["certified_by_endpoints"] == 1 and c["guards"] == 1
+    assert world.counters["collision_queries"] == 1 and world.counters["distance_queries"] == 1
     assert not certifier.check(s.start, np.array([45.0, 35.0, 0.0]))  # end inside a disc
     assert c["rejected_end_state"] == 1 and world.counters["distance_queries"] == 1
     long_edge = certifier.check(s.start, np.array([8.0, 75.0, 0.0]))
     assert long_edge and c["guards"] == world.counters["distance_queries"] > 2
-    assert c["bisection_nodes"] == c["guards"] - 2
+    # the start's guard came from the cache; the far end was measured once
+    assert c["cached_guards"] == 1 and c["endpoint_guards"] == 2
+    assert c["bisection_nodes"] == c["guards"] - c["endpoint_guards"]
+    assert certifier.covered["ball"] > 1.0
+
+
+@pytest.mark.parametrize("certificates", sorted(CERTIFICATE_SETS))
+def test_edges_between_cached_states_need_no_query(certificates):
+    """Once both ends of an edge carry guards, the reversed edge and the edge itself are
+    decided from the cache: not one FCL query."""
+    s = load_scenario(ROOT / "scenarios" / "2d" / "narrow_corridor.yaml")
+    world = CollisionWorld(s)
+    certifier = EdgeCertifier(world, certificates=CERTIFICATE_SETS[certificates])
+    a = np.array([30.0, 30.0, 0.0])  # inside the corridor, 0.5 from both walls
+    b = a + [0.4, 0.05, 0.01]
+    assert certifier.check(a, b)
+    queries = dict(world.counters)
+    assert certifier.check(b, a) and certifier.check(a, b)
+    assert world.counters == queries
+    assert certifier.counters["certified_by_endpoints"] >= 2
+    # a longer edge from a cached state measures only what is new
+    c, measured = a + [20.0, 0.0, 0.0], certifier.counters["endpoint_guards"]
+    assert certifier.check(a, c)
+    assert certifier.counters["endpoint_guards"] == measured + 1  # c, not a
+
+
+def test_sweep_test_and_occupancy_reject_without_guards():
+    """An edge whose robot core crosses a wall is rejected by one capsule query; a state
+    whose centre lies in a learned blocked cell is rejected with no query."""
+    s = load_scenario(ROOT / "scenarios" / "2d" / "narrow_corridor.yaml")
+    world = CollisionWorld(s)
+    certifier = EdgeCertifier(world)
+    assert not certifier.check([10.0, 30.0, 0.0], [100.0, 50.0, 0.0])
+    assert certifier.counters["rejected_sweep"] == 1 and certifier.counters["guards"] == 0
+    inside = np.array([60.0, 10.0, 0.0])  # deep inside the lower wall block
+    assert not certifier.state_valid(inside)
+    assert certifier.counters["occupancy_queries"] == 1
+    queries = dict(world.counters)
+    assert not certifier.state_valid(inside + [0.01, 0.0, 0.5])
+    assert world.counters == queries and certifier.counters["occupancy_rejections"] == 1
 
 
 @pytest.mark.parametrize("path", SUITE, ids=lambda p: Path(p).stem)
@@ -151,7 +209,7 @@ def test_kc_planners_never_return_colliding_paths(path, planner):
     )
 
 
-@pytest.mark.parametrize("planner", [p for p in PLANNERS if not p.startswith("kc")])
+@pytest.mark.parametrize("planner", [p for p in PLANNERS if not PLANNERS[p].kc])
 def test_stock_planners_run_through_the_same_setup(planner):
     scenario = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
     result = plan(scenario, planner, time_limit=1.0, seed=1)

@@ -354,19 +354,21 @@ def test_mesh_obstacle(tmp_path):
 
 def test_counters_increase_once_per_query():
     world = world_2d([{"circle": {"center": [10, 0], "radius": 1}}])
-    assert world.counters == {"collision_queries": 0, "distance_queries": 0}
+    zero = {"collision_queries": 0, "distance_queries": 0, "region_queries": 0, "region_pairs": 0}
+    assert world.counters == zero
     world.in_collision([0, 0, 0])
-    assert world.counters == {"collision_queries": 1, "distance_queries": 0}
+    assert world.counters == zero | {"collision_queries": 1, "distance_queries": 0}
     world.clearance([0, 0, 0])
-    assert world.counters == {"collision_queries": 1, "distance_queries": 1}
+    assert world.counters == zero | {"collision_queries": 1, "distance_queries": 1}
     poses = np.zeros((7, 3))
     world.in_collision_many(poses)
     world.clearance_many(poses)
-    assert world.counters == {"collision_queries": 8, "distance_queries": 8}
+    assert world.counters == zero | {"collision_queries": 8, "distance_queries": 8}
     world.colliding_obstacles([0, 0, 0])  # diagnostics are not counted
-    assert world.counters == {"collision_queries": 8, "distance_queries": 8}
+    assert world.counters == zero | {"collision_queries": 8, "distance_queries": 8}
     world.reset_counters()
-    assert world.counters == {"collision_queries": 0, "distance_queries": 0}
+    zero = {"collision_queries": 0, "distance_queries": 0, "region_queries": 0, "region_pairs": 0}
+    assert world.counters == zero
 
 
 def test_empty_world_and_bad_pose():

@@ -18,14 +18,18 @@ _COLORS = {
     "kc-prm": "#d62728",
     "prm": "#ff9896",
     "kc-rrtconnect-discrete": "#2ca02c",
+    "ca-rrtconnect": "#17becf",
+    "ca-prm": "#e377c2",
+    "kc-rrtconnect-paper": "#8c564b",
+    "kc-prm-paper": "#bcbd22",
     "rrtconnect-fine": "#ff7f0e",
     "prm-fine": "#9467bd",
 }
 
 
 def _color(planner: str, i: int) -> str:
-    # planners without a colour of their own: tab10's cyan, olive, grey and pink (unused above)
-    return _COLORS.get(planner, plt.cm.tab10(9 - i % 4))
+    # planners without a colour of their own: grey shades
+    return _COLORS.get(planner, plt.cm.Greys(0.4 + 0.15 * (i % 4)))
 
 
 def _planners(records: Sequence[dict]) -> list[str]:
@@ -67,7 +71,8 @@ def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.Pa
 
 
 def plot_success_vs_budget(records: Sequence[dict], path: str | os.PathLike) -> None:
-    """Fraction of runs solved within each time budget, one panel per scenario."""
+    """Fraction of runs solved within each time budget, one panel per scenario; a
+    returned path that collides counts as a failure."""
     scenarios = list(dict.fromkeys(r["scenario_name"] for r in records))
     cols = min(4, len(scenarios))
     rows = math.ceil(len(scenarios) / cols)
@@ -78,7 +83,7 @@ def plot_success_vs_budget(records: Sequence[dict], path: str | os.PathLike) -> 
         runs = [r for r in records if r["scenario_name"] == scenario]
         for i, planner in enumerate(_planners(runs)):
             mine = [r for r in runs if r["planner"] == planner]
-            times = np.array([r["time"] for r in mine if r["solved"]])
+            times = np.array([r["time"] for r in mine if r["solved"] and not r["collides"]])
             rate = (times[None, :] <= budgets[:, None]).sum(axis=1) / len(mine)
             ax.step(budgets, rate, where="post", label=planner, color=_color(planner, i))
         ax.set_xscale("log")

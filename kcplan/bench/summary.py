@@ -6,7 +6,10 @@ look fast by failing; ``median_fcl_queries`` (collision plus distance queries, s
 and guards together) is over runs whose worker finished; ``median_length`` is over solved
 runs (OMPL path length after simplification). A kc planner's *twin* is the stock planner
 it wraps (``kc-prm`` -> ``prm``), or its 0.1 % resolution version (``prm-fine``) when
-only that ran; ratios are twin / kc, so above 1 means kc wins.
+only that ran; its *ca twin* is the same planner with the plain clearance-ball
+certificate (``kc-prm`` -> ``ca-prm``, the ablation baseline). Ratios are twin / kc, so
+above 1 means kc wins. ``covered_*`` columns are the share of the edge parameter each
+certificate covered (medians over runs).
 """
 
 from __future__ import annotations
@@ -20,7 +23,14 @@ import numpy as np
 
 from kcplan.planning.names import PLANNER_NAMES
 
-__all__ = ["SUMMARY_COLUMNS", "twin_of", "summarize", "summary_csv", "summary_markdown"]
+__all__ = [
+    "SUMMARY_COLUMNS",
+    "twin_of",
+    "ca_twin_of",
+    "summarize",
+    "summary_csv",
+    "summary_markdown",
+]
 
 SUMMARY_COLUMNS = (
     "scenario",
@@ -46,16 +56,32 @@ EXTRA_COLUMNS = (
     "twin",
     "time_ratio",
     "query_ratio",
+    "ca_twin",
+    "ca_time_ratio",
+    "ca_query_ratio",
+    "share_region",
+    "share_polytope",
+    "share_ball",
 )
 
 
 def twin_of(planner: str) -> str | None:
-    """The stock planner a kc planner wraps, or None (``kc-rrtconnect-discrete`` ->
-    ``rrtconnect``)."""
-    if not planner.startswith("kc-"):
+    """The stock planner a certified planner wraps, or None (``kc-rrtconnect-discrete``,
+    ``ca-rrtconnect``, ``kc-rrtconnect-paper`` -> ``rrtconnect``)."""
+    if not planner.startswith(("kc-", "ca-")):
         return None
-    base = planner[3:].removesuffix("-discrete")
+    base = planner[3:].removesuffix("-discrete").removesuffix("-paper")
     return base if base in PLANNER_NAMES else None
+
+
+def ca_twin_of(planner: str) -> str | None:
+    """The clearance-ball ablation of a ``kc-*`` planner (``kc-prm-paper`` -> ``ca-prm``),
+    or None."""
+    base = twin_of(planner)
+    if not planner.startswith("kc-") or base is None:
+        return None
+    twin = f"ca-{base}"
+    return twin if twin in PLANNER_NAMES else None
 
 
 def _median(values: Sequence[float]) -> float:
@@ -100,6 +126,8 @@ def summarize(records: Sequence[dict]) -> list[dict]:
                 "median_certified_edges": _median(certified),
                 "median_simplify_time": _median([r["simplify_time"] for r in solved]),
                 "twin": twin_of(planner) or "",
+                "ca_twin": ca_twin_of(planner) or "",
+                **_shares(finished),
             }
         )
     by_key = {(r["scenario"], r["planner"]): r for r in rows}
@@ -110,7 +138,24 @@ def summarize(records: Sequence[dict]) -> list[dict]:
         twin = by_key.get((row["scenario"], row["twin"]))
         row["time_ratio"] = _ratio(twin, row, "median_time")
         row["query_ratio"] = _ratio(twin, row, "median_fcl_queries")
+        ca = by_key.get((row["scenario"], row["ca_twin"]))
+        row["ca_time_ratio"] = _ratio(ca, row, "median_time")
+        row["ca_query_ratio"] = _ratio(ca, row, "median_fcl_queries")
     return rows
+
+
+def _shares(runs: Sequence[dict]) -> dict:
+    """Median share of the covered edge parameter won by each certificate."""
+    out = {}
+    for name in ("region", "polytope", "ball"):
+        shares = []
+        for r in runs:
+            covered = {k: v for k, v in r["counters"].items() if k.startswith("kc_covered_")}
+            total = sum(covered.values())
+            if total > 0:
+                shares.append(covered.get(f"kc_covered_{name}", 0.0) / total)
+        out[f"share_{name}"] = _median(shares)
+    return out
 
 
 def _ratio(twin: dict | None, row: dict, column: str) -> float:
@@ -146,13 +191,18 @@ def summary_markdown(rows: Sequence[dict], title: str = "Benchmark summary") -> 
         f"# {title}",
         "",
         "Times are seconds in `solve()`, unsolved runs counted at the time limit; FCL "
-        "queries are collision plus distance queries; *colliding* counts returned paths that "
-        "gap-free verification (`kcplan verify`) found in collision. The last two columns "
-        "compare a kc planner with its stock twin: twin / kc, so above 1 means kc wins.",
+        "queries are collision, distance and region queries (a region query is one "
+        "broad-phase query plus one distance per obstacle piece within the horizon); "
+        "*colliding* counts returned paths that gap-free verification (`kcplan verify`) "
+        "found in collision. *twin/kc* compares a certified planner with the stock planner "
+        "it wraps, *ca/kc* a kc planner with its clearance-ball ablation (`ca-*`): "
+        "twin / kc, so above 1 means kc wins. *region* and *polytope* are the median "
+        "shares of the certified edge parameter won by those certificates.",
         "",
         "| scenario | planner | solved | median time | p90 time | median FCL queries "
-        "| median length | colliding | failed | time twin/kc | queries twin/kc |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| median length | colliding | failed | time twin/kc | queries twin/kc "
+        "| time ca/kc | queries ca/kc | region | polytope |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         out.append(
@@ -160,6 +210,8 @@ def summary_markdown(rows: Sequence[dict], title: str = "Benchmark summary") -> 
             f"| {_fmt(r['median_time'], '.3f')} | {_fmt(r['p90_time'], '.3f')} "
             f"| {_fmt(r['median_fcl_queries'], '.0f')} | {_fmt(r['median_length'], '.2f')} "
             f"| {r['colliding_paths']} | {r['failed_runs']} "
-            f"| {_fmt(r['time_ratio'], '.2f')} | {_fmt(r['query_ratio'], '.2f')} |"
+            f"| {_fmt(r['time_ratio'], '.2f')} | {_fmt(r['query_ratio'], '.2f')} "
+            f"| {_fmt(r['ca_time_ratio'], '.2f')} | {_fmt(r['ca_query_ratio'], '.2f')} "
+            f"| {_fmt(r['share_region'], '.2f')} | {_fmt(r['share_polytope'], '.2f')} |"
         )
     return "\n".join(out) + "\n"

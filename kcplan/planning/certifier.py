@@ -22,6 +22,7 @@ from kcplan.planning.certificates import (
 )
 from kcplan.planning.guard import Guard, GuardCache
 from kcplan.planning.ladder import GuardLadder
+from kcplan.world.occupancy import CoreOccupancy
 
 __all__ = ["CERTIFICATE_SETS", "EdgeCertifier"]
 
@@ -48,6 +49,8 @@ COUNTER_NAMES = (
     "cached_guards",
     "bisection_nodes",
     "collision_queries",
+    "occupancy_rejections",
+    "occupancy_queries",
 )
 
 
@@ -58,7 +61,8 @@ class EdgeCertifier:
     valid, ``p2`` is not. The edge is decided as follows, each step only when the
     previous ones leave part of it open:
 
-    1. ``p2``: skipped when the cache knows it valid, else one collision query, and a
+    1. ``p2``: skipped when the cache knows it valid; rejected with no query when its
+       centre lies in a blocked cell (``occupancy``); else one collision query, and a
        colliding ``p2`` rejects the edge.
     2. Endpoint guards from the cache cover ``[0, lo]`` (guard at ``p1``) and
        ``[hi, 1]`` (guard at ``p2``); ``lo >= hi`` certifies the edge with no query.
@@ -88,8 +92,10 @@ class EdgeCertifier:
         ``sweep_core_collides(t1, t2, radius)``: :class:`kcplan.world.CollisionWorld`.
     semi_axes : array_like, shape (n,), optional
         Default ``world.semi_axes``.
-    certificates : sequence of str
-        Names from :data:`kcplan.planning.certificates.CERTIFICATE_NAMES`.
+    certificates : sequence of str, optional
+        Names from :data:`kcplan.planning.certificates.CERTIFICATE_NAMES`; default
+        ``CERTIFICATE_SETS["kc"]``, or ``("rotation", "polytope")`` for a world without
+        region queries.
     ladder : GuardLadder, optional
         For ``polytope``; built on demand.
     horizon : float, optional
@@ -97,8 +103,13 @@ class EdgeCertifier:
     fallback : {"bisection", "discrete"}
     max_guards : int
         Guards per edge after the endpoints before "not proven".
-    sweep_test : bool
-        Step 3.
+    sweep_test : bool, optional
+        Step 3 (default: when the world has ``sweep_core_collides``).
+    occupancy : bool, optional
+        Reject states whose centre lies in a cell of :class:`CoreOccupancy` proven
+        blocked for every orientation, with no query; a cell is tested (one query) the
+        first time a state in it collides (default: when the world has
+        ``ball_collides`` and ``scenario``).
     cache : GuardCache, optional
         Shared with the state validity checker (see :meth:`state_valid`).
 
@@ -109,14 +120,22 @@ class EdgeCertifier:
         self,
         world,
         semi_axes: ArrayLike | None = None,
-        certificates: Sequence[str] = CERTIFICATE_SETS["kc"],
+        certificates: Sequence[str] | None = None,
         ladder: GuardLadder | None = None,
         horizon: float | None = None,
         fallback: str = "bisection",
         max_guards: int = 64,
-        sweep_test: bool = True,
+        sweep_test: bool | None = None,
         cache: GuardCache | None = None,
+        occupancy: bool | None = None,
     ):
+        regions = hasattr(world, "free_region")
+        if certificates is None:
+            certificates = CERTIFICATE_SETS["kc"] if regions else ("rotation", "polytope")
+        sweep_test = _supported(world, "sweep_test", sweep_test, "sweep_core_collides")
+        occupancy = _supported(world, "occupancy", occupancy, "ball_collides", "scenario")
+        if "region" in certificates and not regions:
+            raise ValueError("certificates: 'region' needs a world with free_region(pose, horizon)")
         if fallback not in ("bisection", "discrete"):
             raise ValueError(f"fallback: expected 'bisection' or 'discrete', got {fallback!r}")
         unknown = [c for c in certificates if c not in CERTIFICATE_NAMES]
@@ -144,6 +163,8 @@ class EdgeCertifier:
         self.max_guards = int(max_guards)
         self.sweep_test = bool(sweep_test)
         self.cache = cache if cache is not None else GuardCache()
+        self.occupancy = occupancy
+        self._grid: CoreOccupancy | None = None
         self.counters = dict.fromkeys(COUNTER_NAMES, 0)
         self.covered = dict.fromkeys((c.name for c in self.certificates), 0.0)
         self.guard_log: list[tuple[np.ndarray, float]] | None = None  # (pose, eps) if enabled
@@ -168,16 +189,28 @@ class EdgeCertifier:
             self.guard_log.append((pose, guard.clearance / float(self.semi_axes.max())))
         return guard
 
-    def state_valid(self, pose: ArrayLike) -> bool:
+    def state_valid(self, pose: ArrayLike, key: bytes | None = None) -> bool:
         """State validity with the cache: one collision query for a pose not seen before,
-        remembered so that a later edge ending there skips its end-state query."""
+        remembered so that a later edge ending there skips its end-state query.
+        ``key`` is ``pose.tobytes()`` when the caller has it."""
         p = np.asarray(pose, dtype=float)
-        key = p.tobytes()
+        key = p.tobytes() if key is None else key
         known = self.cache.validity(key)
         if known is not None:
             return known
+        grid = self._grid
+        if grid is None and self.occupancy:
+            grid = self._grid = CoreOccupancy(self.world)
+        if grid is not None and grid.blocked(p):
+            self.counters["occupancy_rejections"] += 1
+            self.cache.add_validity(key, False)
+            return False
         self.counters["collision_queries"] += 1
         valid = not self.world.in_collision(p)
+        if not valid and grid is not None:  # learn the cell for the next state there
+            before = grid.queries
+            grid.learn(p)
+            self.counters["occupancy_queries"] += grid.queries - before
         self.cache.add_validity(key, valid)
         return valid
 
@@ -194,12 +227,15 @@ class EdgeCertifier:
         with what they cover of ``[s0, s1]``."""
         best_minus = best_plus = 0.0
         win_minus = win_plus = None
+        need_minus, need_plus = m - s0, s1 - m
         for certificate in self.certificates:
             minus, plus = certificate.reach(guard, edge, m)
             if minus > best_minus:
                 best_minus, win_minus = minus, certificate.name
             if plus > best_plus:
                 best_plus, win_plus = plus, certificate.name
+            if best_minus >= need_minus and best_plus >= need_plus:
+                break  # the stretch is covered: later certificates cannot add to it
         lo, hi = m - best_minus, m + best_plus
         if win_minus is not None:
             self.covered[win_minus] += m - max(lo, s0) if m > s0 else 0.0
@@ -221,7 +257,7 @@ class EdgeCertifier:
         k1, k2 = p1.tobytes(), p2.tobytes()
         cache = self.cache
         g1, g2 = cache.guard(k1), cache.guard(k2)
-        if not self.state_valid(p2):
+        if not self.state_valid(p2, k2):
             return self._reject("rejected_end_state")
         edge = Edge(p1, p2, self.n)
         lo, hi = 0.0, 1.0
@@ -292,3 +328,11 @@ class EdgeCertifier:
             if self.world.in_collision(edge.pose(s)):
                 return self._reject("rejected_guard")
         return True
+
+
+def _supported(world, option: str, value: bool | None, *needs: str) -> bool:
+    """An option's value: its default (None) is on exactly when the world supports it."""
+    missing = [name for name in needs if not hasattr(world, name)]
+    if value and missing:
+        raise ValueError(f"{option}: the world has no {', '.join(missing)}")
+    return not missing if value is None else bool(value)

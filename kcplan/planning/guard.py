@@ -36,9 +36,12 @@ class Guard:
     horizon : float
         Every piece not listed is at least this far from the robot (``clearance``
         for a guard without a region).
+    planes : tuple of (nx, ny, nz, slack, clearance)
+        The same rows as plain floats (``nz = 0`` in 2D), for certificates that loop
+        over a handful of pieces faster than numpy can.
     """
 
-    __slots__ = ("pose", "clearance", "normals", "slacks", "clearances", "horizon")
+    __slots__ = ("pose", "clearance", "normals", "slacks", "clearances", "horizon", "planes")
 
     def __init__(
         self,
@@ -56,6 +59,13 @@ class Guard:
         self.slacks = np.zeros(0) if slacks is None else slacks
         self.clearances = np.zeros(0) if clearances is None else clearances
         self.horizon = self.clearance if horizon is None else float(horizon)
+        pad = [0.0] * (3 - n)
+        self.planes = tuple(
+            (*row, *pad, sigma, d)
+            for row, sigma, d in zip(
+                self.normals.tolist(), self.slacks.tolist(), self.clearances.tolist(), strict=True
+            )
+        )
 
     @classmethod
     def from_region(

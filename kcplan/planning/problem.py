@@ -218,6 +218,7 @@ def plan(
     ss.setStartAndGoalStates(start, goal)
     ss.setPlanner(spec.make(si))
     ss.setup()
+
     try:
         ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
         solve_time = float(ss.getLastPlanComputationTime())

@@ -29,7 +29,7 @@ from collections.abc import Sequence
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.certifier import EdgeCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import state_pose
 
@@ -50,9 +50,9 @@ class KCMotionValidator(ob.MotionValidator):
         poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``; ``free_region`` for the
         ``region`` certificate and ``sweep_core_collides`` for ``sweep_test``, e.g.
         :class:`kcplan.world.CollisionWorld`.
-    certificates : sequence of str
-        Default ``("region", "polytope")``; see
-        :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
+    certificates : sequence of str, optional
+        Default ``("region", "polytope")``, or ``("rotation", "polytope")`` when the world
+        has no ``free_region``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
@@ -64,9 +64,10 @@ class KCMotionValidator(ob.MotionValidator):
         Region horizon in length units (default ``max(a)``).
     max_guards : int
         Guards per edge before giving up ("not proven" rejects the edge).
-    sweep_test : bool
+    sweep_test : bool, optional
         Reject an edge whose robot core (ball of radius ``min(a)``) sweeps into an
-        obstacle with one collision query before measuring guards.
+        obstacle with one collision query before measuring guards (default: when the
+        world has ``sweep_core_collides``).
     """
 
     def __init__(
@@ -74,17 +75,19 @@ class KCMotionValidator(ob.MotionValidator):
         si: ob.SpaceInformation,
         semi_axes: ArrayLike,
         world,
-        certificates: Sequence[str] = CERTIFICATE_SETS["kc"],
+        certificates: Sequence[str] | None = None,
         fallback: str = "bisection",
         inflations: Sequence[float] | None = None,
         horizon: float | None = None,
         max_guards: int = 64,
-        sweep_test: bool = True,
+        sweep_test: bool | None = None,
     ):
         super().__init__(si)
         self.si = si
         self.space = si.getStateSpace()
-        ladder = GuardLadder(semi_axes, inflations) if "polytope" in certificates else None
+        ladder = None
+        if certificates is None or "polytope" in certificates:
+            ladder = GuardLadder(semi_axes, inflations)
         self.certifier = EdgeCertifier(
             world,
             semi_axes,

@@ -68,7 +68,8 @@ def _prism(polygon: NDArray, half_height: float) -> fcl.Convex:
 
 
 def _box3(ob: Obstacle) -> fcl.Convex:
-    V = box_vertices(ob.center, ob.rotation, ob.extents)  # index = 4 i + 2 j + k for signs (i, j, k)
+    # corner 4 i + 2 j + k has signs (i, j, k)
+    V = box_vertices(ob.center, ob.rotation, ob.extents)
     quads = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
     faces = np.array([x for q in quads for x in (4, *q)], dtype=np.int32)
     return fcl.Convex(V, 6, faces)
@@ -178,19 +179,23 @@ class CollisionWorld:
             self.counters[key] = 0
 
     def _place(self, pose: ArrayLike) -> None:
-        p = np.asarray(pose, dtype=float)
+        p = pose if isinstance(pose, np.ndarray) else np.asarray(pose, dtype=float)
         if p.shape != (self._pose_size,):
             raise ValueError(
                 f"pose: expected {self._pose_size} numbers in {self.dimension}D, "
                 f"got shape {p.shape}"
             )
+        # plain floats: numpy costs microseconds per call on 4-vectors
         if self.dimension == 2:
-            half = 0.5 * p[2]
-            q = np.array([np.cos(half), 0.0, 0.0, np.sin(half)])
-            self._robot.setTransform(fcl.Transform(q, np.array([p[0], p[1], 0.0])))
+            x, y, yaw = p.tolist()
+            half = 0.5 * yaw
+            q = np.array([math.cos(half), 0.0, 0.0, math.sin(half)])
+            self._robot.setTransform(fcl.Transform(q, np.array([x, y, 0.0])))
         else:
-            q = np.array([p[6], p[3], p[4], p[5]])  # FCL wants [w, x, y, z]
-            self._robot.setTransform(fcl.Transform(q / np.linalg.norm(q), p[:3]))
+            x, y, z, qx, qy, qz, qw = p.tolist()
+            norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+            q = np.array([qw / norm, qx / norm, qy / norm, qz / norm])  # FCL: [w, x, y, z]
+            self._robot.setTransform(fcl.Transform(q, np.array([x, y, z])))
 
     def in_collision(self, pose: ArrayLike) -> bool:
         """Whether the robot at ``pose`` touches or overlaps an obstacle (one FCL query)."""
@@ -269,6 +274,19 @@ class CollisionWorld:
                 offsets[i] = support(normals[i])
         return FreeRegion(normals, offsets, clearances, horizon)
 
+    def ball_collides(self, center: ArrayLike, radius: float) -> bool:
+        """Whether the ball (2D: disc) of ``radius`` about ``center`` meets an obstacle
+        (one FCL collision query; builds :class:`kcplan.world.occupancy.CoreOccupancy`)."""
+        self.counters["collision_queries"] += 1
+        if not self._objects:
+            return False
+        c = np.zeros(3)
+        c[: self.dimension] = np.asarray(center, dtype=float)[: self.dimension]
+        ball = fcl.CollisionObject(fcl.Sphere(float(radius)), fcl.Transform(c))
+        data = fcl.CollisionData()
+        self._manager.collide(ball, data, fcl.defaultCollisionCallback)
+        return bool(data.result.is_collision)
+
     def sweep_core_collides(self, t1: ArrayLike, t2: ArrayLike, radius: float) -> bool:
         """Whether the capsule of ``radius`` around the segment ``t1 -> t2`` (centre
         positions) meets an obstacle (one FCL collision query).
@@ -278,21 +296,23 @@ class CollisionWorld:
         radius, a hit proves that the motion collides; it never proves a motion free.
         """
         n = self.dimension
-        t1 = np.asarray(t1, dtype=float)[:n]
-        t2 = np.asarray(t2, dtype=float)[:n]
+        a = [float(v) for v in t1[:n]] + [0.0] * (3 - n)
+        b = [float(v) for v in t2[:n]] + [0.0] * (3 - n)
         self.counters["collision_queries"] += 1
         if not self._objects:
             return False
-        axis = np.zeros(3)
-        axis[:n] = t2 - t1
-        length = float(np.linalg.norm(axis))
-        centre = np.zeros(3)
-        centre[:n] = 0.5 * (t1 + t2)
-        # rotate the capsule's z axis onto the segment: half-way quaternion [w, x, y, z]
-        z = axis / length if length > 0.0 else np.array([0.0, 0.0, 1.0])
-        q = np.array([1.0 + z[2], -z[1], z[0], 0.0])
-        norm = float(np.linalg.norm(q))
-        q = q / norm if norm > 1e-12 else np.array([0.0, 1.0, 0.0, 0.0])
+        dx, dy, dz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+        length = math.sqrt(dx * dx + dy * dy + dz * dz)
+        centre = np.array([0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])])
+        # the rotation taking the capsule's z axis onto the segment, as the half-way
+        # quaternion [w, x, y, z] = normalise([1 + z . u, z x u]) for u = segment / length
+        if length > 0.0:
+            ux, uy, uz = dx / length, dy / length, dz / length
+        else:
+            ux, uy, uz = 0.0, 0.0, 1.0
+        w, qx, qy = 1.0 + uz, -uy, ux
+        norm = math.sqrt(w * w + qx * qx + qy * qy)
+        q = np.array([w / norm, qx / norm, qy / norm, 0.0] if norm > 1e-9 else [0.0, 1.0, 0.0, 0.0])
         capsule = fcl.CollisionObject(fcl.Capsule(float(radius), length), fcl.Transform(q, centre))
         data = fcl.CollisionData()
         self._manager.collide(capsule, data, fcl.defaultCollisionCallback)

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan.geometry.pose import Edge
@@ -54,22 +53,21 @@ class FreeRegionPlanes:
         speed = edge.translation_speed + turn
         if speed <= 0.0:
             return math.inf, math.inf
-        far = guard.horizon / speed
-        if not len(guard.slacks):
-            return far, far
-        along = guard.normals @ edge.dt
-        ball = guard.clearances / speed
-        slack = guard.slacks
-        return (
-            min(far, float(np.maximum(_plane_reach(slack, turn + along), ball).min())),
-            min(far, float(np.maximum(_plane_reach(slack, turn - along), ball).min())),
-        )
-
-
-def _plane_reach(slack: np.ndarray, rate: np.ndarray) -> np.ndarray:
-    """``slack / rate`` where the slack is used up (``rate > 0``), ``inf`` where it is
-    not, 0 where there is no positive slack to begin with."""
-    positive = slack > 0.0
-    out = np.where(positive, math.inf, 0.0)
-    np.divide(slack, rate, out=out, where=positive & (rate > 0.0))
-    return out
+        minus = plus = guard.horizon / speed
+        if not guard.planes:
+            return minus, plus
+        dx, dy, dz = edge.dt.tolist() + [0.0] * (3 - len(edge.dt))
+        # a handful of pieces: plain floats beat numpy's per-call cost
+        for nx, ny, nz, slack, clearance in guard.planes:
+            ball = clearance / speed
+            along = nx * dx + ny * dy + nz * dz
+            if slack > 0.0:
+                rate = turn - along  # slack used up per unit s going forward
+                ahead = slack / rate if rate > 0.0 else math.inf
+                rate = turn + along  # ... going backward
+                behind = slack / rate if rate > 0.0 else math.inf
+                plus = min(plus, max(ahead, ball))
+                minus = min(minus, max(behind, ball))
+            else:
+                plus, minus = min(plus, ball), min(minus, ball)
+        return minus, plus

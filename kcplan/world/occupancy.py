@@ -1,0 +1,93 @@
+"""Where the robot's centre cannot be: grid cells proven blocked for every orientation.
+
+The robot ``E_a`` contains the ball of radius ``r = min(a)`` about its centre, whatever
+its orientation. For a cell of half-diagonal ``h < r`` centred at ``c``, every centre
+``x`` in the cell has ``B(c, r - h) ⊂ B(x, r) ⊂ E_a(x, R)``; so if the ball
+``B(c, r - h)`` meets an obstacle (one FCL query), every robot pose with its centre in
+the cell collides, and a lookup rejects such a state with no query. The grid only ever
+proves collisions, never freedom.
+
+Cells are tested lazily, when a state in them was found colliding (:meth:`learn`), so a
+problem that samples few colliding states pays for few cells.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["CoreOccupancy"]
+
+_UNKNOWN, _BLOCKED, _OPEN = 0, 1, 2
+
+
+class CoreOccupancy:
+    """A regular grid over the bounds whose cells are learned blocked or not.
+
+    Parameters
+    ----------
+    world : kcplan.world.CollisionWorld
+        Provides ``ball_collides(center, radius)``, ``semi_axes`` and the scenario bounds.
+    max_cells : int
+        Upper bound on the number of cells. Cells have half-diagonal ``min(a) / 2`` unless
+        this bound needs larger ones; when the half-diagonal would reach ``0.9 min(a)``
+        the grid is disabled (``enabled`` False: it never blocks anything).
+
+    Attributes
+    ----------
+    queries : int
+        FCL queries spent testing cells.
+    """
+
+    def __init__(self, world, max_cells: int = 1_000_000):
+        low, high = (np.asarray(b, dtype=float) for b in world.scenario.bounds)
+        n = len(low)
+        r = float(np.min(world.semi_axes))
+        extent = np.maximum(high - low, 1e-12)
+        side = max(float(np.prod(extent) / max_cells) ** (1.0 / n), r / math.sqrt(n))
+        half_diagonal = 0.5 * side * math.sqrt(n)
+        self.world = world
+        self.low, self.side, self.dimension = low.tolist(), side, n
+        self.shape = tuple(int(math.ceil(e / side)) for e in extent)
+        self.enabled = half_diagonal < 0.9 * r
+        self.radius = (r - half_diagonal) * (1.0 - 1e-6)
+        self.queries = 0
+        self._state = np.zeros(self.shape if self.enabled else (0,) * n, dtype=np.int8)
+
+    def _cell(self, position: ArrayLike) -> tuple | None:
+        index = []
+        for k in range(self.dimension):
+            i = int((float(position[k]) - self.low[k]) // self.side)
+            if i < 0 or i >= self.shape[k]:
+                return None
+            index.append(i)
+        return tuple(index)
+
+    def blocked(self, position: ArrayLike) -> bool:
+        """True when the cell of ``position`` is known blocked (no query)."""
+        if not self.enabled:
+            return False
+        cell = self._cell(position)
+        return cell is not None and self._state[cell] == _BLOCKED
+
+    def learn(self, position: ArrayLike) -> bool:
+        """Test the cell of ``position`` if it was never tested (one FCL query); whether
+        it is blocked."""
+        if not self.enabled:
+            return False
+        cell = self._cell(position)
+        if cell is None:
+            return False
+        if self._state[cell] == _UNKNOWN:
+            centre = [lo + (i + 0.5) * self.side for lo, i in zip(self.low, cell, strict=True)]
+            self.queries += 1
+            blocked = self.world.ball_collides(np.array(centre), self.radius)
+            self._state[cell] = _BLOCKED if blocked else _OPEN
+        return bool(self._state[cell] == _BLOCKED)
+
+    @property
+    def blocked_fraction(self) -> float:
+        """Fraction of all cells known blocked."""
+        return float((self._state == _BLOCKED).mean()) if self._state.size else 0.0
