@@ -22,7 +22,7 @@ from kcplan.bench.campaign import (
     run_campaign,
     run_isolated,
 )
-from kcplan.bench.summary import SUMMARY_COLUMNS, summarize, twin_of
+from kcplan.bench.summary import SUMMARY_COLUMNS, ca_twin_of, summarize, twin_of
 from kcplan.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -322,7 +322,7 @@ def test_dask_executor_gives_the_same_results_as_local(tmp_path):
 
 
 def test_summary_statistics_by_hand():
-    def rec(planner, run, solved, t, q, collides=False, status="ok"):
+    def rec(planner, run, solved, t, q, collides=False, status="ok", covered=None):
         return {
             "scenario_name": "s",
             "planner": planner,
@@ -335,16 +335,26 @@ def test_summary_statistics_by_hand():
             "simplify_time": 0.1,
             "length": 5.0 + run,
             "collides": collides,
-            "counters": {"fcl_queries": q},
+            "counters": {"fcl_queries": q, **(covered or {})},
         }
 
     records = [
         rec("rrtconnect", 0, True, 1.0, 1000, collides=True),
         rec("rrtconnect", 1, True, 3.0, 3000),
         rec("rrtconnect", 2, False, 10.0, 9000),
-        rec("kc-rrtconnect", 0, True, 0.5, 100),
+        rec("kc-rrtconnect", 0, True, 0.5, 100, covered={"kc_covered_region": 3.0}),
         rec("kc-rrtconnect", 1, True, 1.5, 300),
-        rec("kc-rrtconnect", 2, True, 2.5, 500),
+        rec(
+            "kc-rrtconnect",
+            2,
+            True,
+            2.5,
+            500,
+            covered={"kc_covered_region": 1.0, "kc_covered_polytope": 1.0},
+        ),
+        rec("ca-rrtconnect", 0, True, 3.0, 600),
+        rec("ca-rrtconnect", 1, True, 3.0, 600),
+        rec("ca-rrtconnect", 2, True, 3.0, 600),
     ]
     rows = {r["planner"]: r for r in summarize(records)}
     stock, kc = rows["rrtconnect"], rows["kc-rrtconnect"]
@@ -354,7 +364,15 @@ def test_summary_statistics_by_hand():
     assert stock["median_length"] == 5.5 and stock["colliding_paths"] == 1
     assert kc["time_ratio"] == 2.0 and kc["query_ratio"] == 10.0
     assert math.isnan(stock["time_ratio"])
+    # the clearance-ball ablation is kc's second twin; its own twin is the stock planner
+    assert kc["ca_twin"] == "ca-rrtconnect" and rows["ca-rrtconnect"]["twin"] == "rrtconnect"
+    assert kc["ca_time_ratio"] == 2.0 and kc["ca_query_ratio"] == 2.0
+    assert math.isnan(rows["ca-rrtconnect"]["ca_time_ratio"])
+    # certificate shares: medians over the runs that covered something (1.0 and 0.5)
+    assert kc["share_region"] == 0.75 and kc["share_polytope"] == 0.25
     assert twin_of("kc-prm") == "prm" and twin_of("kc-rrtconnect-discrete") == "rrtconnect"
+    assert twin_of("kc-prm-paper") == "prm" and ca_twin_of("kc-prm-paper") == "ca-prm"
+    assert ca_twin_of("ca-prm") is None and ca_twin_of("prm") is None
     assert twin_of("prm") is None
     # with only the fine-resolution stock planner in the campaign, it is the twin
     fine = [
@@ -367,7 +385,7 @@ def test_summary_statistics_by_hand():
 
 def test_polytope_cache_round_trip_and_repair(tmp_path, monkeypatch):
     from kcplan.kc.convex import ConvexLowerBound
-    from kcplan.planning import certificate
+    from kcplan.planning import ladder as certificate
 
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
     certificate._halfspaces.cache_clear()

@@ -213,7 +213,8 @@ class Edge:
         """The pose ``q(s)``."""
         t = self.t1 + s * self.dt
         if self.n == 2:
-            return np.array([t[0], t[1], float(wrap_angle(self.yaw1 + s * self.w[0]))])
+            yaw = (self.yaw1 + s * float(self.w[0]) + math.pi) % (2.0 * math.pi) - math.pi
+            return np.array([t[0], t[1], yaw])  # wrap_angle in plain floats
         return np.array([t[0], t[1], t[2], *self._rotation(s)])
 
     def _rotation(self, s: float) -> NDArray:

@@ -40,6 +40,7 @@ COUNTER_NAMES = (
     "rejected",
     "rejected_end_state",
     "rejected_sweep",
+    "rejected_occupancy",
     "rejected_guard",
     "not_proven",
     "certified_by_endpoints",
@@ -61,14 +62,17 @@ class EdgeCertifier:
     valid, ``p2`` is not. The edge is decided as follows, each step only when the
     previous ones leave part of it open:
 
-    1. ``p2``: skipped when the cache knows it valid; rejected with no query when its
-       centre lies in a blocked cell (``occupancy``); else one collision query, and a
-       colliding ``p2`` rejects the edge.
+    1. ``p2``: skipped when the cache knows it valid; else the edge is rejected with no
+       query when its centre passes through a cell the occupancy grid knows blocked
+       (``occupancy``, see step 3), then one collision query at ``p2``, and a colliding
+       ``p2`` rejects the edge.
     2. Endpoint guards from the cache cover ``[0, lo]`` (guard at ``p1``) and
        ``[hi, 1]`` (guard at ``p2``); ``lo >= hi`` certifies the edge with no query.
-    3. Cheap rejection (``sweep_test``): the robot contains the ball of radius
-       ``min(a)`` about its centre, so if the capsule swept by that ball over
-       ``[lo, hi]`` meets an obstacle (one collision query), the edge collides.
+    3. Cheap rejection. The robot contains the ball of radius ``min(a)`` about its
+       centre, so the edge collides if its centre passes through a cell the occupancy
+       grid knows blocked (no query; done in step 1 unless ``p2`` was cached), or
+       (``sweep_test``) if the capsule swept by that ball over ``[lo, hi]`` meets an
+       obstacle (one collision query).
     4. Missing endpoint guards are measured and cached (a state the planner keeps is
        never queried twice).
     5. Advancement: a guard at the middle of each open stretch, removing what it covers,
@@ -257,6 +261,9 @@ class EdgeCertifier:
         k1, k2 = p1.tobytes(), p2.tobytes()
         cache = self.cache
         g1, g2 = cache.guard(k1), cache.guard(k2)
+        grid = self._grid
+        if g2 is None and grid is not None and grid.segment_blocked(p1, p2):
+            return self._reject("rejected_occupancy")  # before any query
         if not self.state_valid(p2, k2):
             return self._reject("rejected_end_state")
         edge = Edge(p1, p2, self.n)
@@ -270,6 +277,8 @@ class EdgeCertifier:
         if lo >= hi:
             c["certified_by_endpoints"] += 1
             return True
+        if g2 is not None and grid is not None and grid.segment_blocked(p1, p2):
+            return self._reject("rejected_occupancy")
         if self.sweep_test:
             c["collision_queries"] += 1
             if self.world.sweep_core_collides(edge.pose(lo), edge.pose(hi), self.core_radius):

@@ -221,6 +221,8 @@ def plan(
 
     try:
         ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
+        if validator is not None:
+            validator.raise_error()
         solve_time = float(ss.getLastPlanComputationTime())
         solved = bool(ss.haveExactSolutionPath())
         simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
@@ -229,6 +231,8 @@ def plan(
             if simplify:
                 t0 = time.perf_counter()
                 ss.simplifySolution(float(time_limit))
+                if validator is not None:
+                    validator.raise_error()
                 simplify_time = time.perf_counter() - t0
             path = ss.getSolutionPath()
             states = [state_pose(s, n).tolist() for s in path.getStates()]

@@ -99,6 +99,7 @@ class KCMotionValidator(ob.MotionValidator):
             sweep_test,
         )
         self.n = self.certifier.n
+        self.error: Exception | None = None
 
     @property
     def counters(self) -> dict:
@@ -114,14 +115,29 @@ class KCMotionValidator(ob.MotionValidator):
         return self.certifier.state_valid(state_pose(state, self.n))
 
     def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
-        resolution = 0.01
-        if self.certifier.fallback == "discrete":
-            length = self.space.distance(s1, s2)
-            step = self.si.getStateValidityCheckingResolution() * self.space.getMaximumExtent()
-            resolution = min(1.0, step / length) if length > 0 else 1.0
-        return bool(
-            self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
-        )
+        if self.error is not None:
+            return False
+        try:
+            resolution = 0.01
+            if self.certifier.fallback == "discrete":
+                length = self.space.distance(s1, s2)
+                extent = self.space.getMaximumExtent()
+                step = self.si.getStateValidityCheckingResolution() * extent
+                resolution = min(1.0, step / length) if length > 0 else 1.0
+            return bool(
+                self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
+            )
+        except Exception as err:  # through PRM's C++ threads an exception aborts
+            self.error = err  # rejecting is always safe; raise_error() re-raises after solve
+            return False
+
+    def raise_error(self) -> None:
+        """Re-raise the first exception a ``checkMotion`` call caught, if any. An exception
+        must not cross OMPL's C++ frames (through PRM's worker threads it aborts the
+        process), so ``checkMotion`` rejects the edge, stores the exception and makes
+        every later call reject; call this after ``solve()``."""
+        if self.error is not None:
+            raise self.error
 
     def close(self) -> None:
         """Drop references to OMPL objects (call when done; see ompl-python-notes 6)."""

@@ -114,6 +114,7 @@ class CollisionWorld:
         self.semi_axes = a
         self.scenario = scenario
         geometry = fcl.Ellipsoid(*a) if n == 3 else fcl.Ellipsoid(a[0], a[1], float(a.min()))
+        self._robot_geometry = geometry
         self._robot = fcl.CollisionObject(geometry, fcl.Transform())
         self._half_height = float(max(a.max(), 1.0))
         self._objects: list[fcl.CollisionObject] = []
@@ -263,10 +264,14 @@ class CollisionWorld:
             if d <= 0.0:
                 return FreeRegion.colliding(n)
             clearances[i] = max(d * rtol - self.clearance_atol, 0.0)
-            support = self._supports[self._piece_of[id(result.o2)]]
+            # FCL swaps the pair (and its nearest points) for some geometry types (meshes)
+            if result.o1 is self._robot_geometry:
+                piece, (p_robot, p_obstacle) = result.o2, result.nearest_points
+            else:
+                piece, (p_obstacle, p_robot) = result.o1, result.nearest_points
+            support = self._supports[self._piece_of[id(piece)]]
             if support is None:
                 continue
-            p_robot, p_obstacle = result.nearest_points
             direction = (p_robot - p_obstacle)[:n]
             length = math.sqrt(float(direction @ direction))
             if length > 0.0:

@@ -55,6 +55,7 @@ class CoreOccupancy:
         self.radius = (r - half_diagonal) * (1.0 - 1e-6)
         self.queries = 0
         self._state = np.zeros(self.shape if self.enabled else (0,) * n, dtype=np.int8)
+        self._low, self._shape = np.array(self.low), np.array(self.shape)
 
     def _cell(self, position: ArrayLike) -> tuple | None:
         index = []
@@ -86,6 +87,25 @@ class CoreOccupancy:
             blocked = self.world.ball_collides(np.array(centre), self.radius)
             self._state[cell] = _BLOCKED if blocked else _OPEN
         return bool(self._state[cell] == _BLOCKED)
+
+    def segment_blocked(self, start: ArrayLike, end: ArrayLike) -> bool:
+        """True when a point of the segment ``start -> end`` (centre positions) lies in a
+        cell known blocked (no query). Points are taken every half cell, so a blocked cell
+        the segment only clips may be missed: a False proves nothing."""
+        if not self.enabled:
+            return False
+        if self.blocked(end):  # a new state in an obstacle is the common case: look there first
+            return True
+        n = self.dimension
+        a = np.asarray(start[:n], dtype=float)
+        b = np.asarray(end[:n], dtype=float)
+        steps = min(int(2.0 * math.dist(a, b) / self.side) + 1, 400)
+        points = a + np.linspace(0.0, 1.0, steps + 1)[:, None] * (b - a)
+        cells = ((points - self._low) // self.side).astype(np.intp)
+        inside = ((cells >= 0) & (cells < self._shape)).all(axis=1)
+        if not inside.all():
+            cells = cells[inside]
+        return bool((self._state[tuple(cells.T)] == _BLOCKED).any())
 
     @property
     def blocked_fraction(self) -> float:

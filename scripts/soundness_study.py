@@ -1,0 +1,131 @@
+"""Soundness of the edge certificates on random edges, checked independently (issue 12).
+
+Random worlds of thin rotated walls, boxes and balls (2D and 3D, several robot shapes),
+random edges from a free state closer to an obstacle than the robot's size (short, medium
+and long, with and without rotation), each
+decided by the certifier with every certificate set of the ablation (``ca``, ``kc-paper``,
+``kc``). Every accepted edge is re-checked by gap-free conservative advancement with FCL
+clearances (:func:`kcplan.planning.verify.verify_path`, which shares no code with the
+certificates); a *violation* is an accepted edge that check finds in collision, and must
+be 0. A *free edge rejected* is a rejected edge the check finds free (the price of
+proving). Prints a Markdown table::
+
+    python scripts/soundness_study.py [--edges 100000] [--seed 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.ladder import GuardLadder
+from kcplan.planning.verify import verify_path
+from kcplan.world import CollisionWorld, parse_scenario
+
+SHAPES = {
+    2: ([5.0, 3.5], [1.0, 0.4], [3.0, 3.0], [8.0, 1.0]),
+    3: ([4.0, 2.5, 2.0], [1.0, 1.0, 0.3]),
+}
+
+
+def random_pose(rng: np.random.Generator, n: int, low: float, high: float) -> np.ndarray:
+    t = rng.uniform(low, high, n)
+    if n == 2:
+        return np.array([*t, rng.uniform(-np.pi, np.pi)])
+    q = rng.normal(size=4)
+    return np.concatenate([t, q / np.linalg.norm(q)])
+
+
+def random_world(rng: np.random.Generator, n: int, semi_axes) -> CollisionWorld:
+    """Thin rotated walls, boxes and balls in a 50-wide box."""
+    obstacles = []
+    for _ in range(int(rng.integers(6, 16))):
+        c = rng.uniform(-20, 20, n).tolist()
+        kind = rng.integers(3)
+        if kind == 0:
+            size = [float(rng.uniform(0.01, 0.2))] + [float(rng.uniform(5, 30))] * (n - 1)
+            box = {"center": c, "size": rng.permutation(size).tolist()}
+            if n == 2:
+                box["yaw"] = float(rng.uniform(-np.pi, np.pi))
+            else:
+                q = rng.normal(size=4)
+                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
+            obstacles.append({"box": box})
+        elif kind == 1:
+            key = "circle" if n == 2 else "sphere"
+            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.5, 5))}})
+        else:
+            obstacles.append({"box": {"center": c, "size": rng.uniform(1, 8, n).tolist()}})
+    data = {
+        "name": "soundness",
+        "dimension": n,
+        "bounds": {"low": [-25] * n, "high": [25] * n},
+        "robot": {"semi_axes": list(semi_axes)},
+        "start": {"position": [0] * n},
+        "goal": {"position": [1] + [0] * (n - 1)},
+        "obstacles": obstacles,
+    }
+    return CollisionWorld(parse_scenario(data, check=False))
+
+
+def study(n: int, edges: int, rng: np.random.Generator) -> dict:
+    """Counts per certificate set for ``edges`` random edges in ``n`` dimensions."""
+    counts = {
+        name: dict.fromkeys(("accepted", "violations", "free_rejected"), 0)
+        for name in CERTIFICATE_SETS
+    }
+    done = 0
+    while done < edges:
+        a = SHAPES[n][int(rng.integers(len(SHAPES[n])))]
+        world = random_world(rng, n, a)
+        ladder = GuardLadder(a)
+        certifiers = {
+            name: EdgeCertifier(world, a, kinds, ladder if "polytope" in kinds else None)
+            for name, kinds in CERTIFICATE_SETS.items()
+        }
+        for _ in range(200):
+            p1 = random_pose(rng, n, -22, 22)
+            if not 0.0 < world.clearance(p1) < max(a):  # free, and near an obstacle
+                continue
+            p2 = p1.copy()
+            p2[:n] += rng.normal(0, rng.choice([0.5, 3.0, 15.0]), n)
+            if rng.random() < 0.5:
+                p2[n:] = random_pose(rng, n, 0, 1)[n:]
+            collides = verify_path(world, [p1, p2]).collides
+            for name, certifier in certifiers.items():
+                ok = certifier.check(p1, p2)
+                c = counts[name]
+                c["accepted"] += ok
+                c["violations"] += ok and collides
+                c["free_rejected"] += (not ok) and not collides
+            done += 1
+            if done >= edges:
+                break
+    return counts
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--edges", type=int, default=100_000, help="edges per dimension")
+    parser.add_argument("--seed", type=int, default=1)
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    print("| dimension | certificates | edges | accepted | violations | free edges rejected |")
+    print("|---|---|---|---|---|---|")
+    for n in (2, 3):
+        t0 = time.perf_counter()
+        counts = study(n, args.edges, rng)
+        for name, c in counts.items():
+            print(
+                f"| {n}D | {name} | {args.edges} | {c['accepted']} | {c['violations']} "
+                f"| {c['free_rejected']} |",
+                flush=True,
+            )
+        print(f"<!-- {n}D: {time.perf_counter() - t0:.0f} s -->", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,327 @@
+"""Certificates, guards, region queries and the occupancy grid, each against an
+independent check: FCL collision queries on dense samples, brute-force distances, or
+the closed-form support function."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kcplan.geometry.pose import Edge
+from kcplan.geometry.rotations import exp_rotation
+from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
+from kcplan.planning.guard import Guard, GuardCache
+from kcplan.world import CollisionWorld, parse_scenario
+from kcplan.world.occupancy import CoreOccupancy
+
+axes2 = st.lists(st.floats(0.1, 10.0), min_size=2, max_size=2)
+axes3 = st.lists(st.floats(0.1, 10.0), min_size=3, max_size=3)
+unit = st.floats(-1.0, 1.0)
+
+
+def corridor_world(semi_axes=(5.0, 3.5)) -> CollisionWorld:
+    """Two slabs 1 apart from the robot along y; a rotated wall and a disc elsewhere."""
+    data = {
+        "name": "corridor",
+        "dimension": 2,
+        "bounds": {"low": [0, 0], "high": [120, 60]},
+        "robot": {"semi_axes": list(semi_axes)},
+        "start": {"position": [10, 30]},
+        "goal": {"position": [110, 30]},
+        "obstacles": [
+            {"box": {"center": [60, 13], "size": [60, 26]}},
+            {"box": {"center": [60, 47], "size": [60, 26]}},
+            {"box": {"center": [105, 45], "size": [0.1, 20], "yaw": 0.4}},
+            {"circle": {"center": [12, 50], "radius": 4}},
+        ],
+    }
+    return CollisionWorld(parse_scenario(data, check=False))
+
+
+def random_world(rng, n, a) -> CollisionWorld:
+    obstacles = []
+    for _ in range(8):
+        c = rng.uniform(-15, 15, n).tolist()
+        kind = rng.integers(3)
+        if kind == 0:
+            size = rng.uniform(0.05, 10, n).tolist()
+            box = {"center": c, "size": size}
+            if n == 2:
+                box["yaw"] = float(rng.uniform(-3, 3))
+            else:
+                q = rng.normal(size=4)
+                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
+            obstacles.append({"box": box})
+        elif kind == 1:
+            key = "circle" if n == 2 else "sphere"
+            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.3, 3))}})
+        else:
+            key = "ellipse" if n == 2 else "ellipsoid"
+            obstacles.append({key: {"center": c, "semi_axes": rng.uniform(0.3, 4, n).tolist()}})
+    data = {
+        "name": "random",
+        "dimension": n,
+        "bounds": {"low": [-20] * n, "high": [20] * n},
+        "robot": {"semi_axes": list(a)},
+        "start": {"position": [0] * n},
+        "goal": {"position": [1] + [0] * (n - 1)},
+        "obstacles": obstacles,
+    }
+    return CollisionWorld(parse_scenario(data, check=False))
+
+
+def random_pose(rng, n, low, high):
+    t = rng.uniform(low, high, n)
+    if n == 2:
+        return np.array([*t, rng.uniform(-np.pi, np.pi)])
+    q = rng.normal(size=4)
+    return np.concatenate([t, q / np.linalg.norm(q)])
+
+
+# ------------------------------------------------------------- rotation lever
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    a=st.one_of(axes2, axes3),
+    n=st.tuples(unit, unit, unit),
+    w=st.tuples(unit, unit, unit),
+    phi=st.floats(-3.2, 3.2),
+)
+def test_support_function_turns_at_most_at_the_lever_rate(a, n, w, phi):
+    """``| |A R(phi)^T n| - |A n| | <= (a_max - a_min) |phi|`` for any axis (ball.py)."""
+    a = np.array(a)
+    d = len(a)
+    direction = np.array(n[:d])
+    if np.linalg.norm(direction) < 1e-3:
+        return
+    direction /= np.linalg.norm(direction)
+    if d == 2:
+        R = exp_rotation(np.array([phi]), 2).reshape(2, 2)
+    else:
+        axis = np.array(w)
+        if np.linalg.norm(axis) < 1e-3:
+            return
+        R = exp_rotation(phi * axis / np.linalg.norm(axis), 3).reshape(3, 3)
+    change = abs(np.linalg.norm(a * (R.T @ direction)) - np.linalg.norm(a * direction))
+    assert change <= (a.max() - a.min()) * abs(phi) + 1e-9
+
+
+def test_lever_is_tight_in_2d():
+    """The largest rate over directions equals a_max - a_min (so the bound is the best)."""
+    a = np.array([5.0, 3.5])
+    phis = np.linspace(0, 2 * np.pi, 20001)
+    h = np.hypot(a[0] * np.cos(phis), a[1] * np.sin(phis))
+    rate = np.abs(np.diff(h)) / np.diff(phis)
+    assert rate.max() == pytest.approx(a.max() - a.min(), rel=1e-3)
+
+
+# ------------------------------------------------------------- region queries
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_region_query_lists_every_piece_within_the_horizon(n):
+    rng = np.random.default_rng(n)
+    a = [2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8]
+    for _ in range(5):
+        world = random_world(rng, n, a)
+        for _ in range(30):
+            pose = random_pose(rng, n, -18, 18)
+            horizon = float(rng.uniform(0.5, 6))
+            region = world.free_region(pose, horizon)
+            exact = world.clearance(pose)
+            if exact <= 0.0:
+                assert region.clearance == 0.0
+                continue
+            # brute force: every FCL object's own distance
+            world._place(pose)
+            import fcl
+
+            distances = [fcl.distance(world._robot, o) for o in world._objects]
+            assert region.size >= sum(d < horizon for d in distances)
+            assert region.clearance <= exact + 1e-9  # never an overestimate
+            if exact < horizon:
+                assert region.clearance == pytest.approx(exact, rel=5e-3, abs=1e-4)
+            else:
+                assert region.clearance >= min(horizon, exact * 0.99)
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_planes_contain_their_piece_and_the_slack_never_exceeds_the_distance(n):
+    """Each plane's offset is the piece's exact support; so the robot's slack to it is a
+    lower bound of the true distance, and near the true distance for the nearest piece."""
+    rng = np.random.default_rng(10 + n)
+    a = np.array([2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8])
+    checked = 0
+    for _ in range(5):
+        world = random_world(rng, n, a)
+        for _ in range(40):
+            pose = random_pose(rng, n, -18, 18)
+            region = world.free_region(pose, 5.0)
+            if region.clearance <= 0.0 or region.size == 0:
+                continue
+            guard = Guard.from_region(pose, region, a, 0.0)
+            for sigma, d in zip(guard.slacks, guard.clearances, strict=True):
+                if np.isfinite(sigma):
+                    raw = (d + world.clearance_atol) / (1 - 2e-3)  # FCL's own distance
+                    assert sigma <= raw + 1e-7
+                    assert sigma >= 0.5 * d  # FCL's nearest points give a good plane
+                    checked += 1
+    assert checked > 50
+
+
+# ------------------------------------------------------------- reach soundness
+
+
+def dense_free(world, edge, lo, hi, samples=60) -> bool:
+    s = np.clip(np.linspace(lo, hi, samples), 0.0, 1.0)
+    return not world.in_collision_many([edge.pose(x) for x in s]).any()
+
+
+@pytest.mark.parametrize("n", [2, 3])
+@pytest.mark.parametrize("certificate", ["ball", "rotation", "region"])
+def test_reach_of_every_certificate_is_collision_free(n, certificate):
+    rng = np.random.default_rng(20 + n)
+    a = np.array([2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8])
+    make = {
+        "ball": lambda: ClearanceBall(a),
+        "rotation": lambda: ClearanceBall(a, rotation_aware=True),
+        "region": lambda: FreeRegionPlanes(a),
+    }
+    cert = make[certificate]()
+    tested = 0
+    for _ in range(6):
+        world = random_world(rng, n, a)
+        for _ in range(80):
+            p1 = random_pose(rng, n, -18, 18)
+            if not 0.0 < world.clearance(p1) < 3.0:
+                continue
+            p2 = p1.copy()
+            p2[:n] += rng.normal(0, 6.0, n)
+            p2[n:] = random_pose(rng, n, 0, 1)[n:]
+            edge = Edge(p1, p2, n)
+            m = float(rng.uniform(0, 1))
+            g = edge.pose(m)
+            region = world.free_region(g, 4.0)
+            guard = Guard.from_region(g, region, a, world.clearance_atol)
+            if guard.clearance <= 0.0:
+                continue
+            minus, plus = cert.reach(guard, edge, m)
+            assert minus > 0 and plus > 0
+            assert dense_free(world, edge, m - minus, m + plus)
+            tested += 1
+    assert tested > 40
+
+
+def test_region_certifies_motion_along_a_wall_for_free():
+    """In a corridor 1 wider than the robot, the ball covers about 2 x 0.5 of motion;
+    the planes cover the whole 40-long stretch (up to the horizon)."""
+    world = corridor_world()
+    a = world.semi_axes
+    p1, p2 = np.array([35.0, 30.0, 0.0]), np.array([85.0, 30.0, 0.0])
+    edge = Edge(p1, p2, 2)
+    guard = Guard.from_region(p1, world.free_region(p1, 50.0), a, world.clearance_atol)
+    _, ball = ClearanceBall(a).reach(guard, edge, 0.0)
+    _, planes = FreeRegionPlanes(a).reach(guard, edge, 0.0)
+    assert ball == pytest.approx(0.5 / 50, rel=0.01)
+    assert planes >= 1.0 and dense_free(world, edge, 0.0, 1.0, 400)
+    # turning in the corridor spends the slack: yaw 0.1 rad costs 1.5 x 0.1 per plane
+    turn = Edge(p1, p1 + [0.0, 0.0, 1.0], 2)
+    _, planes = FreeRegionPlanes(a).reach(guard, turn, 0.0)
+    assert planes == pytest.approx(0.5 / 1.5, rel=0.01)
+
+
+def test_planes_of_a_mesh_piece_fall_back_to_its_clearance():
+    """A piece without a plane (``-inf`` slack) only covers what its clearance ball does:
+    a zero direction row can never give an infinite reach."""
+    a = np.array([2.0, 1.0])
+    guard = Guard(np.zeros(3), 0.5, np.zeros((1, 2)), np.array([-math.inf]), np.array([0.5]), 10.0)
+    edge = Edge(np.zeros(3), np.array([4.0, 0.0, 0.0]), 2)
+    assert FreeRegionPlanes(a).reach(guard, edge, 0.0) == (0.125, 0.125)
+
+
+# ------------------------------------------------------------- cache and grid
+
+
+def test_guard_cache_is_bounded_and_keyed_by_exact_pose():
+    cache = GuardCache(max_entries=100)
+    poses = np.random.default_rng(0).normal(size=(1000, 3))
+    for p in poses:
+        cache.add_guard(p.tobytes(), Guard(p, 1.0))
+    assert len(cache) <= 100
+    last = poses[-1]
+    assert cache.guard(last.tobytes()) is not None
+    assert cache.guard(np.nextafter(last, 1).tobytes()) is None  # one ulp away: a miss
+    cache.add_validity(b"x", False)
+    assert cache.validity(b"x") is False and cache.validity(b"y") is None
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_blocked_cells_block_every_orientation(n):
+    rng = np.random.default_rng(30 + n)
+    a = [2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8]
+    world = random_world(rng, n, a)
+    grid = CoreOccupancy(world)
+    assert grid.enabled
+    blocked = 0
+    for _ in range(3000):
+        pose = random_pose(rng, n, -20, 20)
+        if world.in_collision(pose) and grid.learn(pose[:n]):
+            blocked += 1
+            for _ in range(5):  # any centre in the cell, any orientation
+                other = random_pose(rng, n, 0, 1)
+                cell = np.floor((pose[:n] - grid.low) / grid.side)
+                other[:n] = grid.low + (cell + rng.uniform(0, 1, n)) * grid.side
+                assert grid.blocked(other[:n]) and world.in_collision(other)
+    assert blocked > 20
+    assert not grid.blocked(np.full(n, 1e6))  # outside the bounds: nothing is known
+
+
+def test_region_queries_and_certified_edges_with_meshes():
+    """Meshes have no plane (FCL also swaps their pairs): their clearance still counts, and
+    every accepted edge among them is free under gap-free verification."""
+    from pathlib import Path
+
+    from kcplan.planning.certifier import EdgeCertifier
+    from kcplan.planning.verify import verify_path
+    from kcplan.world import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    scenario = load_scenario(root / "scenarios" / "3d" / "open_space.yaml")
+    assert any(ob.kind == "mesh" for ob in scenario.obstacles)
+    world = CollisionWorld(scenario)
+    certifier = EdgeCertifier(world)
+    rng = np.random.default_rng(7)
+    low, high = scenario.bounds
+    accepted = 0
+    for _ in range(400):
+        p1 = random_pose(rng, 3, 0, 1)
+        p1[:3] = rng.uniform(low, high)
+        if not certifier.state_valid(p1):
+            continue
+        p2 = p1.copy()
+        p2[:3] += rng.normal(0, 10.0, 3)
+        if certifier.check(p1, p2):
+            accepted += 1
+            assert not verify_path(world, [p1, p2]).collides
+    assert accepted > 100
+
+
+def test_an_exception_in_the_validator_is_raised_after_solve_not_through_ompl():
+    """Through PRM's C++ threads an exception would abort the process: the validator
+    rejects, keeps it, and plan() raises it after solve()."""
+    from pathlib import Path
+
+    from kcplan.planning.problem import plan
+    from kcplan.world import load_scenario
+
+    class BrokenWorld(CollisionWorld):
+        def free_region(self, pose, horizon):
+            raise RuntimeError("region query failed")
+
+    root = Path(__file__).resolve().parents[1]
+    scenario = load_scenario(root / "scenarios" / "2d" / "maze.yaml")
+    with pytest.raises(RuntimeError, match="region query failed"):
+        plan(scenario, "kc-prm", 1.0, seed=1, world=BrokenWorld(scenario))
