@@ -51,8 +51,8 @@ class KCMotionValidator(ob.MotionValidator):
         ``region`` certificate and ``sweep_core_collides`` for ``sweep_test``, e.g.
         :class:`kcplan.world.CollisionWorld`.
     certificates : sequence of str, optional
-        Default ``("region", "polytope")``, or ``("rotation", "polytope")`` when the world
-        has no ``free_region``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
+        Default ``("region",)``, or ``("rotation",)`` when the world has no
+        ``free_region``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
@@ -86,7 +86,7 @@ class KCMotionValidator(ob.MotionValidator):
         self.si = si
         self.space = si.getStateSpace()
         ladder = None
-        if certificates is None or "polytope" in certificates:
+        if certificates is not None and "polytope" in certificates:
             ladder = GuardLadder(semi_axes, inflations)
         self.certifier = EdgeCertifier(
             world,

@@ -54,8 +54,9 @@ class CoreOccupancy:
         self.enabled = half_diagonal < 0.9 * r
         self.radius = (r - half_diagonal) * (1.0 - 1e-6)
         self.queries = 0
-        self._state = np.zeros(self.shape if self.enabled else (0,) * n, dtype=np.int8)
-        self._low, self._shape = np.array(self.low), np.array(self.shape)
+        self._blocked_cells = 0
+        # tested cells only (a dict: no cost for the cells never visited)
+        self._cells: dict[tuple[int, ...], int] = {}
 
     def _cell(self, position: ArrayLike) -> tuple | None:
         index = []
@@ -71,7 +72,7 @@ class CoreOccupancy:
         if not self.enabled:
             return False
         cell = self._cell(position)
-        return cell is not None and self._state[cell] == _BLOCKED
+        return cell is not None and self._cells.get(cell) == _BLOCKED
 
     def learn(self, position: ArrayLike) -> bool:
         """Test the cell of ``position`` if it was never tested (one FCL query); whether
@@ -81,33 +82,43 @@ class CoreOccupancy:
         cell = self._cell(position)
         if cell is None:
             return False
-        if self._state[cell] == _UNKNOWN:
+        state = self._cells.get(cell, _UNKNOWN)
+        if state == _UNKNOWN:
             centre = [lo + (i + 0.5) * self.side for lo, i in zip(self.low, cell, strict=True)]
             self.queries += 1
-            blocked = self.world.ball_collides(np.array(centre), self.radius)
-            self._state[cell] = _BLOCKED if blocked else _OPEN
-        return bool(self._state[cell] == _BLOCKED)
+            state = _BLOCKED if self.world.ball_collides(np.array(centre), self.radius) else _OPEN
+            self._cells[cell] = state
+            self._blocked_cells += state == _BLOCKED
+        return state == _BLOCKED
 
     def segment_blocked(self, start: ArrayLike, end: ArrayLike) -> bool:
         """True when a point of the segment ``start -> end`` (centre positions) lies in a
-        cell known blocked (no query). Points are taken every half cell, so a blocked cell
-        the segment only clips may be missed: a False proves nothing."""
+        cell known blocked (no query). Points are taken one cell length apart, so a
+        blocked cell the segment only clips may be missed: a False proves nothing."""
         if not self.enabled:
             return False
-        if self.blocked(end):  # a new state in an obstacle is the common case: look there first
-            return True
         n = self.dimension
-        a = np.asarray(start[:n], dtype=float)
-        b = np.asarray(end[:n], dtype=float)
-        steps = min(int(2.0 * math.dist(a, b) / self.side) + 1, 400)
-        points = a + np.linspace(0.0, 1.0, steps + 1)[:, None] * (b - a)
-        cells = ((points - self._low) // self.side).astype(np.intp)
-        inside = ((cells >= 0) & (cells < self._shape)).all(axis=1)
-        if not inside.all():
-            cells = cells[inside]
-        return bool((self._state[tuple(cells.T)] == _BLOCKED).any())
+        a = [float(v) for v in start[:n]]
+        b = [float(v) for v in end[:n]]
+        d = [y - x for x, y in zip(a, b, strict=True)]
+        steps = min(int(math.dist(a, b) / self.side) + 1, 256)
+        cells, low, side, shape = self._cells, self.low, self.side, self.shape
+        # one point per cell length, from the end backwards: a new state in an obstacle,
+        # the common case, is found first; plain floats beat numpy on a few points
+        for j in range(steps, -1, -1):
+            f = j / steps
+            cell = []
+            for k in range(n):
+                i = int((a[k] + f * d[k] - low[k]) // side)
+                if i < 0 or i >= shape[k]:
+                    break
+                cell.append(i)
+            else:
+                if cells.get(tuple(cell)) == _BLOCKED:
+                    return True
+        return False
 
     @property
     def blocked_fraction(self) -> float:
         """Fraction of all cells known blocked."""
-        return float((self._state == _BLOCKED).mean()) if self._state.size else 0.0
+        return self._blocked_cells / math.prod(self.shape) if self.enabled else 0.0
