@@ -38,6 +38,8 @@ class PlannerSpec:
     fallback: str = "bisection"
     description: str = ""
     resolution: float | None = None  # OMPL's state validity checking resolution (stock)
+    range_factor: float | None = None  # RRT-Connect range, fraction of the maximum extent
+    neighbors: int | None = None  # PRM's maximum nearest neighbours (OMPL default 10)
 
     @property
     def kc(self) -> bool:
@@ -216,8 +218,13 @@ def plan(
     set_state(start, scenario.start, n)
     set_state(goal, scenario.goal, n)
     ss.setStartAndGoalStates(start, goal)
-    ss.setPlanner(spec.make(si))
+    planner_object = spec.make(si)
+    ss.setPlanner(planner_object)
     ss.setup()
+    if spec.range_factor is not None:
+        planner_object.setRange(spec.range_factor * space.getMaximumExtent())
+    if spec.neighbors is not None:
+        planner_object.setMaxNearestNeighbors(spec.neighbors)
 
     try:
         ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
