@@ -237,7 +237,7 @@ def test_planes_of_a_mesh_piece_fall_back_to_its_clearance():
     """A piece without a plane (``-inf`` slack) only covers what its clearance ball does:
     a zero direction row can never give an infinite reach."""
     a = np.array([2.0, 1.0])
-    guard = Guard(np.zeros(3), 0.5, np.zeros((1, 2)), np.array([-math.inf]), np.array([0.5]), 10.0)
+    guard = Guard(np.zeros(3), 0.5, ((0.0, 0.0, 0.0, -math.inf, 0.5),), 10.0)
     edge = Edge(np.zeros(3), np.array([4.0, 0.0, 0.0]), 2)
     assert FreeRegionPlanes(a).reach(guard, edge, 0.0) == (0.125, 0.125)
 

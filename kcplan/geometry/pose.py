@@ -116,20 +116,18 @@ def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> tuple[float, float, float
     )
 
 
-def rotate_vector(q: NDArray, v: NDArray) -> NDArray[np.float64]:
-    """Rotate ``v`` (shape (3,)) by the unit quaternion ``q = [x, y, z, w]``.
+def rotate_vector(q: ArrayLike, v: ArrayLike) -> tuple[float, float, float]:
+    """Rotate ``v`` (3 numbers) by the unit quaternion ``q = [x, y, z, w]``, as a tuple.
 
     ``v + w t + u x t`` with ``t = 2 u x v`` (written out: ``np.cross`` costs about 20 us
     on 3-vectors, more than an FCL query)."""
     ux, uy, uz, w = (float(c) for c in q)
     vx, vy, vz = (float(c) for c in v)
     tx, ty, tz = 2.0 * (uy * vz - uz * vy), 2.0 * (uz * vx - ux * vz), 2.0 * (ux * vy - uy * vx)
-    return np.array(
-        [
-            vx + w * tx + uy * tz - uz * ty,
-            vy + w * ty + uz * tx - ux * tz,
-            vz + w * tz + ux * ty - uy * tx,
-        ]
+    return (
+        vx + w * tx + uy * tz - uz * ty,
+        vy + w * ty + uz * tx - ux * tz,
+        vz + w * tz + ux * ty - uy * tx,
     )
 
 

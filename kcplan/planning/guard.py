@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.geometry.pose import pose_frame
+from kcplan.geometry.pose import rotate_vector
 from kcplan.world.region import FreeRegion
 
 __all__ = ["Guard", "GuardCache"]
@@ -27,45 +27,37 @@ class Guard:
     clearance : float
         Distance from the robot to every obstacle, never an overestimate (0: touching or
         too close to tell).
-    normals, slacks, clearances : ndarray, shapes (k, n), (k,), (k,)
-        For each obstacle piece within ``horizon`` (region guards only; ``k = 0``
-        otherwise): the unit direction from the piece towards the robot, the robot's
-        *slack* ``sigma_i = n_i . t - |A R^T n_i| - c_i - margin`` (by how much the robot
-        clears the piece's separating plane ``n_i . x <= c_i``; ``-inf`` without a plane),
-        and the robot's clearance to the piece.
+    planes : tuple of (nx, ny, nz, slack, clearance)
+        One row per obstacle piece within ``horizon`` (region guards only; empty
+        otherwise), as plain floats (certificates loop over a handful of pieces faster
+        than numpy can): the unit direction from the piece towards the robot (``nz = 0``
+        in 2D); the robot's *slack* ``sigma_i = n_i . t - |A R^T n_i| - c_i - margin``,
+        by how much the robot clears the piece's separating plane ``n_i . x <= c_i``
+        (``-inf`` without a plane); and the robot's clearance to the piece.
     horizon : float
         Every piece not listed is at least this far from the robot (``clearance``
         for a guard without a region).
-    planes : tuple of (nx, ny, nz, slack, clearance)
-        The same rows as plain floats (``nz = 0`` in 2D), for certificates that loop
-        over a handful of pieces faster than numpy can.
     """
 
-    __slots__ = ("pose", "clearance", "normals", "slacks", "clearances", "horizon", "planes")
+    __slots__ = ("pose", "clearance", "planes", "horizon")
 
     def __init__(
-        self,
-        pose: NDArray,
-        clearance: float,
-        normals: NDArray | None = None,
-        slacks: NDArray | None = None,
-        clearances: NDArray | None = None,
-        horizon: float | None = None,
+        self, pose: NDArray, clearance: float, planes: tuple = (), horizon: float | None = None
     ):
         self.pose = pose
         self.clearance = float(clearance)
-        n = 2 if len(pose) == 3 else 3
-        self.normals = np.zeros((0, n)) if normals is None else normals
-        self.slacks = np.zeros(0) if slacks is None else slacks
-        self.clearances = np.zeros(0) if clearances is None else clearances
+        self.planes = planes
         self.horizon = self.clearance if horizon is None else float(horizon)
-        pad = [0.0] * (3 - n)
-        self.planes = tuple(
-            (*row, *pad, sigma, d)
-            for row, sigma, d in zip(
-                self.normals.tolist(), self.slacks.tolist(), self.clearances.tolist(), strict=True
-            )
-        )
+
+    @property
+    def slacks(self) -> NDArray[np.float64]:
+        """The planes' slacks, shape (k,)."""
+        return np.array([row[3] for row in self.planes])
+
+    @property
+    def clearances(self) -> NDArray[np.float64]:
+        """The pieces' clearances, shape (k,)."""
+        return np.array([row[4] for row in self.planes])
 
     @classmethod
     def from_region(
@@ -78,22 +70,42 @@ class Guard:
         ``n . x <= c`` exactly when ``n . t - |A R^T n| - c > 0``; ``margin`` (a length)
         absorbs floating-point rounding of that evaluation.
         """
-        n = len(semi_axes)
         if region.clearance <= 0.0:
             return cls(pose, 0.0)
-        normals = region.normals
-        slacks = np.full(region.size, -math.inf)
-        planes = np.isfinite(region.offsets)
-        if planes.any():
-            R, t = pose_frame(pose, n)
-            body = normals[planes] @ R * semi_axes  # rows: (A R^T n_i)^T
-            slacks[planes] = (
-                normals[planes] @ t
-                - np.sqrt(np.einsum("ij,ij->i", body, body))
-                - region.offsets[planes]
-                - margin
-            )
-        return cls(pose, region.clearance, normals, slacks, region.clearances, region.horizon)
+        p = pose.tolist()
+        a = [float(v) for v in semi_axes]
+        rows = []
+        if len(a) == 2:
+            tx, ty, yaw = p
+            c, s = math.cos(yaw), math.sin(yaw)
+            for (nx, ny), offset, d in zip(
+                region.normals.tolist(),
+                region.offsets.tolist(),
+                region.clearances.tolist(),
+                strict=True,
+            ):
+                slack = -math.inf
+                if offset < math.inf:
+                    bx, by = a[0] * (c * nx + s * ny), a[1] * (c * ny - s * nx)  # A R^T n
+                    slack = nx * tx + ny * ty - math.sqrt(bx * bx + by * by) - offset - margin
+                rows.append((nx, ny, 0.0, slack, d))
+        else:
+            tx, ty, tz, qx, qy, qz, qw = p
+            norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+            conjugate = (-qx / norm, -qy / norm, -qz / norm, qw / norm)
+            for (nx, ny, nz), offset, d in zip(
+                region.normals.tolist(),
+                region.offsets.tolist(),
+                region.clearances.tolist(),
+                strict=True,
+            ):
+                slack = -math.inf
+                if offset < math.inf:
+                    ux, uy, uz = rotate_vector(conjugate, (nx, ny, nz))  # R^T n
+                    h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)
+                    slack = nx * tx + ny * ty + nz * tz - h - offset - margin
+                rows.append((nx, ny, nz, slack, d))
+        return cls(pose, region.clearance, tuple(rows), region.horizon)
 
 
 class GuardCache:

@@ -236,7 +236,9 @@ class CollisionWorld:
         Pieces are found by their FCL bounding boxes overlapping the cube of half side
         ``max(a) + horizon`` around the robot's centre, which contains every point within
         ``horizon`` of the robot; a piece outside it is therefore at least ``horizon``
-        away. Returns :meth:`FreeRegion.colliding` as soon as a piece touches the robot.
+        away. With no piece that close, one distance query (counted as such) widens the
+        horizon to the robot's clearance. Returns :meth:`FreeRegion.colliding` as soon as
+        a piece touches the robot.
         """
         n = self.dimension
         self._place(pose)
@@ -255,29 +257,33 @@ class CollisionWorld:
         near: list[fcl.CollisionObject] = []
         self._manager.collide(box, None, lambda o1, _o2, _data: near.append(o1) or False)
         self.counters["region_pairs"] += len(near)
-        k = len(near)
-        normals, offsets, clearances = np.zeros((k, n)), np.full(k, math.inf), np.empty(k)
+        if not near:  # open space: the clearance to everything is the better horizon
+            return FreeRegion.empty(n, max(horizon, self.safe_clearance(p)))
+        normals, offsets, clearances = [], [], []
         robot, request, rtol = self._robot, self._pair_request, 1.0 - CLEARANCE_RTOL
-        for i, obstacle in enumerate(near):
+        for obstacle in near:
             result = fcl.DistanceResult()
             d = fcl.distance(robot, obstacle, request, result)
             if d <= 0.0:
                 return FreeRegion.colliding(n)
-            clearances[i] = max(d * rtol - self.clearance_atol, 0.0)
+            clearances.append(max(d * rtol - self.clearance_atol, 0.0))
             # FCL swaps the pair (and its nearest points) for some geometry types (meshes)
             if result.o1 is self._robot_geometry:
                 piece, (p_robot, p_obstacle) = result.o2, result.nearest_points
             else:
                 piece, (p_obstacle, p_robot) = result.o1, result.nearest_points
             support = self._supports[self._piece_of[id(piece)]]
-            if support is None:
-                continue
             direction = (p_robot - p_obstacle)[:n]
             length = math.sqrt(float(direction @ direction))
-            if length > 0.0:
-                normals[i] = direction / length
-                offsets[i] = support(normals[i])
-        return FreeRegion(normals, offsets, clearances, horizon)
+            if support is None or length == 0.0:
+                normals.append(np.zeros(n))
+                offsets.append(math.inf)
+                continue
+            normals.append(direction / length)
+            offsets.append(support(normals[-1]))
+        return FreeRegion(
+            np.array(normals).reshape(-1, n), np.array(offsets), np.array(clearances), horizon
+        )
 
     def ball_collides(self, center: ArrayLike, radius: float) -> bool:
         """Whether the ball (2D: disc) of ``radius`` about ``center`` meets an obstacle
