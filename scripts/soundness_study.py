@@ -10,7 +10,7 @@ certificates); a *violation* is an accepted edge that check finds in collision, 
 be 0. A *free edge rejected* is a rejected edge the check finds free (the price of
 proving). Prints a Markdown table::
 
-    python scripts/soundness_study.py [--edges 100000] [--seed 1]
+    python scripts/soundness_study.py [--edges 100000] [--seed 1] [--dimensions 2 3]
 """
 
 from __future__ import annotations
@@ -111,11 +111,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--edges", type=int, default=100_000, help="edges per dimension")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--dimensions", type=int, nargs="+", default=[2, 3], choices=[2, 3])
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     print("| dimension | certificates | edges | accepted | violations | free edges rejected |")
     print("|---|---|---|---|---|---|")
-    for n in (2, 3):
+    for n in args.dimensions:
         t0 = time.perf_counter()
         counts = study(n, args.edges, rng)
         for name, c in counts.items():
