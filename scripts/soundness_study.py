@@ -1,6 +1,7 @@
 """Soundness of the edge certificates on random edges, checked independently (issue 12).
 
-Random worlds of thin rotated walls, boxes and balls (2D and 3D, several robot shapes),
+Random worlds of thin rotated walls, balls, boxes and ellipsoids
+(:mod:`kcplan.world.clutter`; 2D and 3D, several robot shapes),
 random edges from a free state closer to an obstacle than the robot's size (short, medium
 and long, with and without rotation), each
 decided by the certifier with every certificate set of the ablation (``ca``, ``kc-paper``,
@@ -23,52 +24,13 @@ import numpy as np
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, parse_scenario
+from kcplan.world import CollisionWorld
+from kcplan.world.clutter import random_pose, random_scenario
 
 SHAPES = {
     2: ([5.0, 3.5], [1.0, 0.4], [3.0, 3.0], [8.0, 1.0]),
     3: ([4.0, 2.5, 2.0], [1.0, 1.0, 0.3]),
 }
-
-
-def random_pose(rng: np.random.Generator, n: int, low: float, high: float) -> np.ndarray:
-    t = rng.uniform(low, high, n)
-    if n == 2:
-        return np.array([*t, rng.uniform(-np.pi, np.pi)])
-    q = rng.normal(size=4)
-    return np.concatenate([t, q / np.linalg.norm(q)])
-
-
-def random_world(rng: np.random.Generator, n: int, semi_axes) -> CollisionWorld:
-    """Thin rotated walls, boxes and balls in a 50-wide box."""
-    obstacles = []
-    for _ in range(int(rng.integers(6, 16))):
-        c = rng.uniform(-20, 20, n).tolist()
-        kind = rng.integers(3)
-        if kind == 0:
-            size = [float(rng.uniform(0.01, 0.2))] + [float(rng.uniform(5, 30))] * (n - 1)
-            box = {"center": c, "size": rng.permutation(size).tolist()}
-            if n == 2:
-                box["yaw"] = float(rng.uniform(-np.pi, np.pi))
-            else:
-                q = rng.normal(size=4)
-                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
-            obstacles.append({"box": box})
-        elif kind == 1:
-            key = "circle" if n == 2 else "sphere"
-            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.5, 5))}})
-        else:
-            obstacles.append({"box": {"center": c, "size": rng.uniform(1, 8, n).tolist()}})
-    data = {
-        "name": "soundness",
-        "dimension": n,
-        "bounds": {"low": [-25] * n, "high": [25] * n},
-        "robot": {"semi_axes": list(semi_axes)},
-        "start": {"position": [0] * n},
-        "goal": {"position": [1] + [0] * (n - 1)},
-        "obstacles": obstacles,
-    }
-    return CollisionWorld(parse_scenario(data, check=False))
 
 
 def study(n: int, edges: int, rng: np.random.Generator) -> dict:
@@ -80,7 +42,7 @@ def study(n: int, edges: int, rng: np.random.Generator) -> dict:
     done = 0
     while done < edges:
         a = SHAPES[n][int(rng.integers(len(SHAPES[n])))]
-        world = random_world(rng, n, a)
+        world = CollisionWorld(random_scenario(rng, n, a, int(rng.integers(6, 16))))
         ladder = GuardLadder(a)
         certifiers = {
             name: EdgeCertifier(world, a, kinds, ladder if "polytope" in kinds else None)

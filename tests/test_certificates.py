@@ -14,6 +14,7 @@ from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
 from kcplan.planning.guard import Guard, GuardCache
 from kcplan.world import CollisionWorld, parse_scenario
+from kcplan.world.clutter import random_pose, random_scenario
 from kcplan.world.occupancy import CoreOccupancy
 
 axes2 = st.lists(st.floats(0.1, 10.0), min_size=2, max_size=2)
@@ -38,46 +39,6 @@ def corridor_world(semi_axes=(5.0, 3.5)) -> CollisionWorld:
         ],
     }
     return CollisionWorld(parse_scenario(data, check=False))
-
-
-def random_world(rng, n, a) -> CollisionWorld:
-    obstacles = []
-    for _ in range(8):
-        c = rng.uniform(-15, 15, n).tolist()
-        kind = rng.integers(3)
-        if kind == 0:
-            size = rng.uniform(0.05, 10, n).tolist()
-            box = {"center": c, "size": size}
-            if n == 2:
-                box["yaw"] = float(rng.uniform(-3, 3))
-            else:
-                q = rng.normal(size=4)
-                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
-            obstacles.append({"box": box})
-        elif kind == 1:
-            key = "circle" if n == 2 else "sphere"
-            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.3, 3))}})
-        else:
-            key = "ellipse" if n == 2 else "ellipsoid"
-            obstacles.append({key: {"center": c, "semi_axes": rng.uniform(0.3, 4, n).tolist()}})
-    data = {
-        "name": "random",
-        "dimension": n,
-        "bounds": {"low": [-20] * n, "high": [20] * n},
-        "robot": {"semi_axes": list(a)},
-        "start": {"position": [0] * n},
-        "goal": {"position": [1] + [0] * (n - 1)},
-        "obstacles": obstacles,
-    }
-    return CollisionWorld(parse_scenario(data, check=False))
-
-
-def random_pose(rng, n, low, high):
-    t = rng.uniform(low, high, n)
-    if n == 2:
-        return np.array([*t, rng.uniform(-np.pi, np.pi)])
-    q = rng.normal(size=4)
-    return np.concatenate([t, q / np.linalg.norm(q)])
 
 
 # ------------------------------------------------------------- rotation lever
@@ -126,7 +87,7 @@ def test_region_query_lists_every_piece_within_the_horizon(n):
     rng = np.random.default_rng(n)
     a = [2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8]
     for _ in range(5):
-        world = random_world(rng, n, a)
+        world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
         for _ in range(30):
             pose = random_pose(rng, n, -18, 18)
             horizon = float(rng.uniform(0.5, 6))
@@ -156,7 +117,7 @@ def test_planes_contain_their_piece_and_the_slack_never_exceeds_the_distance(n):
     a = np.array([2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8])
     checked = 0
     for _ in range(5):
-        world = random_world(rng, n, a)
+        world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
         for _ in range(40):
             pose = random_pose(rng, n, -18, 18)
             region = world.free_region(pose, 5.0)
@@ -193,7 +154,7 @@ def test_reach_of_every_certificate_is_collision_free(n, certificate):
     cert = make[certificate]()
     tested = 0
     for _ in range(6):
-        world = random_world(rng, n, a)
+        world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
         for _ in range(80):
             p1 = random_pose(rng, n, -18, 18)
             if not 0.0 < world.clearance(p1) < 3.0:
@@ -262,7 +223,7 @@ def test_guard_cache_is_bounded_and_keyed_by_exact_pose():
 def test_blocked_cells_block_every_orientation(n):
     rng = np.random.default_rng(30 + n)
     a = [2.0, 1.0] if n == 2 else [2.0, 1.2, 0.8]
-    world = random_world(rng, n, a)
+    world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
     grid = CoreOccupancy(world)
     assert grid.enabled
     blocked = 0

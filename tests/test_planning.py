@@ -20,18 +20,11 @@ from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, load_scenario, parse_scenario
+from kcplan.world import CollisionWorld, load_scenario
+from kcplan.world.clutter import random_pose, random_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 SUITE = sorted(glob.glob(str(ROOT / "scenarios" / "*" / "*.yaml")))
-
-
-def random_pose(rng, n, low, high):
-    t = rng.uniform(low, high, n)
-    if n == 2:
-        return np.array([*t, rng.uniform(-np.pi, np.pi)])
-    q = rng.normal(size=4)
-    return np.concatenate([t, q / np.linalg.norm(q)])
 
 
 def relative_xi(pose_from, pose_to, n):
@@ -64,38 +57,6 @@ def test_edge_matches_ompl_interpolation(n):
             assert np.allclose(xi, (s - m) * edge.direction(m), atol=1e-8)
 
 
-def random_world(rng, n, a):
-    """Random obstacles around a 40-wide box, including thin walls."""
-    obstacles = []
-    for _ in range(int(rng.integers(2, 7))):
-        c = rng.uniform(-20, 20, n).tolist()
-        kind = rng.integers(3)
-        if kind == 0:  # thin wall, rotated
-            size = [float(rng.uniform(0.01, 0.2))] + [float(rng.uniform(5, 30))] * (n - 1)
-            box = {"center": c, "size": rng.permutation(size).tolist()}
-            if n == 2:
-                box["yaw"] = float(rng.uniform(-np.pi, np.pi))
-            else:
-                q = rng.normal(size=4)
-                box["quaternion"] = (q / np.linalg.norm(q)).tolist()
-            obstacles.append({"box": box})
-        elif kind == 1:
-            key = "circle" if n == 2 else "sphere"
-            obstacles.append({key: {"center": c, "radius": float(rng.uniform(0.5, 5))}})
-        else:
-            obstacles.append({"box": {"center": c, "size": rng.uniform(1, 8, n).tolist()}})
-    data = {
-        "name": "random",
-        "dimension": n,
-        "bounds": {"low": [-25] * n, "high": [25] * n},
-        "robot": {"semi_axes": list(a)},
-        "start": {"position": [0] * n},
-        "goal": {"position": [1] + [0] * (n - 1)},
-        "obstacles": obstacles,
-    }
-    return CollisionWorld(parse_scenario(data, check=False))
-
-
 @pytest.mark.parametrize("certificates", sorted(CERTIFICATE_SETS))
 @pytest.mark.parametrize(
     "n, shapes, edges_per_world",
@@ -113,7 +74,7 @@ def test_accepted_edges_are_free_and_colliding_edges_rejected(
     for a in shapes:
         ladder = GuardLadder(a, (0.01, 0.05, 0.2) if n == 3 else None)
         for _ in range(8 if n == 2 else 6):
-            world = random_world(rng, n, a)
+            world = CollisionWorld(random_scenario(rng, n, a, int(rng.integers(2, 7))))
             kinds = CERTIFICATE_SETS[certificates]
             certifier = EdgeCertifier(world, a, kinds, ladder if "polytope" in kinds else None)
             for _ in range(edges_per_world):

@@ -73,38 +73,30 @@ class Guard:
         if region.clearance <= 0.0:
             return cls(pose, 0.0)
         p = pose.tolist()
-        a = [float(v) for v in semi_axes]
-        rows = []
-        if len(a) == 2:
-            tx, ty, yaw = p
-            c, s = math.cos(yaw), math.sin(yaw)
-            for (nx, ny), offset, d in zip(
-                region.normals.tolist(),
-                region.offsets.tolist(),
-                region.clearances.tolist(),
-                strict=True,
-            ):
-                slack = -math.inf
-                if offset < math.inf:
-                    bx, by = a[0] * (c * nx + s * ny), a[1] * (c * ny - s * nx)  # A R^T n
-                    slack = nx * tx + ny * ty - math.sqrt(bx * bx + by * by) - offset - margin
-                rows.append((nx, ny, 0.0, slack, d))
+        a = [float(v) for v in semi_axes] + [0.0] * (3 - len(semi_axes))
+        if len(semi_axes) == 2:  # a yaw is a rotation about z: the 3D formula serves
+            t = (p[0], p[1], 0.0)
+            conjugate = (0.0, 0.0, -math.sin(0.5 * p[2]), math.cos(0.5 * p[2]))
         else:
-            tx, ty, tz, qx, qy, qz, qw = p
+            t = tuple(p[:3])
+            qx, qy, qz, qw = p[3:]
             norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
             conjugate = (-qx / norm, -qy / norm, -qz / norm, qw / norm)
-            for (nx, ny, nz), offset, d in zip(
-                region.normals.tolist(),
-                region.offsets.tolist(),
-                region.clearances.tolist(),
-                strict=True,
-            ):
-                slack = -math.inf
-                if offset < math.inf:
-                    ux, uy, uz = rotate_vector(conjugate, (nx, ny, nz))  # R^T n
-                    h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)
-                    slack = nx * tx + ny * ty + nz * tz - h - offset - margin
-                rows.append((nx, ny, nz, slack, d))
+        pad = [0.0] * (3 - len(semi_axes))
+        rows = []
+        for normal, offset, d in zip(
+            region.normals.tolist(),
+            region.offsets.tolist(),
+            region.clearances.tolist(),
+            strict=True,
+        ):
+            nx, ny, nz = normal + pad
+            slack = -math.inf
+            if offset < math.inf:
+                ux, uy, uz = rotate_vector(conjugate, (nx, ny, nz))  # R^T n
+                h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)  # |A R^T n|
+                slack = nx * t[0] + ny * t[1] + nz * t[2] - h - offset - margin
+            rows.append((nx, ny, nz, slack, d))
         return cls(pose, region.clearance, tuple(rows), region.horizon)
 
 
