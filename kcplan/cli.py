@@ -134,7 +134,14 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 
 def _print_counters(counters: dict) -> None:
-    keys = ["fcl_queries", "collision_queries", "distance_queries", "checker_calls"]
+    keys = [
+        "fcl_queries",
+        "collision_queries",
+        "distance_queries",
+        "region_queries",
+        "region_pairs",
+        "checker_calls",
+    ]
     print("fcl queries     : " + ", ".join(f"{k} {counters[k]}" for k in keys if k in counters))
     kc = {k[3:]: v for k, v in counters.items() if k.startswith("kc_")}
     if kc:

@@ -33,8 +33,9 @@ CERTIFICATE_SETS = {
 }
 """The certificate sets of the ablation planners (``ca-*``, ``kc-*-paper``, ``kc-*``).
 ``region`` includes a rotation-aware clearance ball per obstacle piece, so ``rotation``
-adds nothing to it; adding ``polytope`` to it won less than 0.2 % of the certified edge
-parameter on the six narrow passages (``benchmarks/RESULTS.md``), so it is left out."""
+adds nothing to it; added to it, ``polytope`` won at most 0.001 % of the certified edge
+parameter on the six narrow passages (``benchmarks/RESULTS.md``, section 0.1), so it is
+left out."""
 
 COUNTER_NAMES = (
     "edges",
