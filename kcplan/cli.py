@@ -93,6 +93,23 @@ def _cmd_bounds(args: argparse.Namespace) -> int:
     return 0
 
 
+def _output_file(path: str | None, option: str, suffixes: tuple[str, ...] = ()) -> None:
+    """Refuse an output file before any work: its folder must exist (no lost plan)."""
+    if path is None:
+        return
+    out = Path(path)
+    if suffixes and out.suffix.lower() not in suffixes:
+        raise InputError(
+            f"{out}: {option}: expected a {' or '.join(suffixes)} file name, got {out.name!r}"
+        )
+    if not out.parent.is_dir():
+        raise InputError(
+            f"{out}: {option}: expected a file in an existing folder, got {out.parent}"
+        )
+    if out.is_dir():
+        raise InputError(f"{out}: {option}: expected a file name, got a folder")
+
+
 def _load(path: str, check: bool = True):
     """Load a scenario, turning every problem with it into an :class:`InputError`."""
     from kcplan.world import ScenarioError, load_scenario
@@ -124,6 +141,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
+    _output_file(args.output, "-o", (".png",))
     scenario = _load(args.scenario)
     out = args.output or str(Path(args.scenario).with_suffix(".png"))
     from kcplan.viz import plot_scenario
@@ -149,6 +167,8 @@ def _print_counters(counters: dict) -> None:
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
+    _output_file(args.output, "-o")
+    _output_file(args.plot, "--plot", (".png",))
     scenario = _load(args.scenario)
     from kcplan.planning.problem import plan
 
@@ -216,6 +236,10 @@ def _read_path(path: str, scenario) -> np.ndarray:
         )
     if not np.isfinite(states).all():
         raise InputError(f"{path}: states: expected finite numbers")
+    if scenario.dimension == 2:  # yaw in [-pi, pi), as OMPL and the scenario loader keep it
+        from kcplan.geometry.pose import wrap_angle
+
+        states[:, 2] = wrap_angle(states[:, 2])
     if data.get("dimension", scenario.dimension) != scenario.dimension:
         raise InputError(
             f"{path}: dimension: expected {scenario.dimension}, got {data['dimension']}"
@@ -345,10 +369,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
     from kcplan.world import ScenarioError, dump_scenario, parse_scenario
 
     out = Path(args.output)
-    if out.suffix not in (".yaml", ".yml"):
-        raise InputError(f"{out}: -o: expected a .yaml file name, got {out.name!r}")
-    if not out.parent.is_dir():
-        raise InputError(f"{out}: -o: expected an existing folder, got {out.parent}")
+    _output_file(args.output, "-o", (".yaml", ".yml"))
     try:
         if args.source == "hrm":
             from kcplan.maps.hrm import import_hrm
@@ -444,6 +465,9 @@ def _finite_float(text: str) -> float:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="kcplan", description=__doc__.splitlines()[0])
+    from kcplan import __version__
+
+    parser.add_argument("--version", action="version", version=f"kcplan {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p = sub.add_parser(
         "bounds",

@@ -1,6 +1,8 @@
 import json
+import math
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -50,3 +52,54 @@ def test_bad_input_is_one_line_and_exit_2(argv, message):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_version_is_printed():
+    proc = subprocess.run(
+        [sys.executable, "-m", "kcplan.cli", "--version"], capture_output=True, text=True
+    )
+    from kcplan import __version__
+
+    assert proc.returncode == 0 and proc.stdout.strip() == f"kcplan {__version__}"
+
+
+OPEN_FIELD = str(Path(__file__).resolve().parents[1] / "scenarios" / "2d" / "open_field.yaml")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["plan", OPEN_FIELD, "-o", "/nonexistent/dir/x.json"],
+            "-o: expected a file in an existing folder",
+        ),
+        (["plan", OPEN_FIELD, "--plot", "/nonexistent/dir/x.png"], "--plot: expected a file in"),
+        (["plan", OPEN_FIELD, "--plot", "x.jpg"], "--plot: expected a .png file name"),
+        (["show", OPEN_FIELD, "-o", "/nonexistent/x.png"], "-o: expected a file in an existing"),
+    ],
+)
+def test_output_paths_are_checked_before_any_work(argv, message, capsys):
+    """A missing output folder is refused with one line and exit 2 before planning, so
+    no plan is lost to a traceback at the end."""
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # nothing planned or drawn
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], captured.err
+
+
+@pytest.mark.parametrize("yaw", [math.pi, 3.1416, -math.pi, 7.0])
+def test_start_yaw_is_normalised_for_ompl(yaw, tmp_path, capsys):
+    """OMPL's SO(2) holds [-pi, pi]: a yaw outside was an invalid start and 'not solved'."""
+    from kcplan.world import load_scenario
+
+    text = Path(OPEN_FIELD).read_text()
+    data = __import__("yaml").safe_load(text)
+    data["start"]["yaw"] = yaw
+    path = tmp_path / "s.yaml"
+    path.write_text(json.dumps(data))
+    scenario = load_scenario(path)
+    assert -math.pi <= scenario.start[2] < math.pi
+    assert math.isclose(math.cos(scenario.start[2]), math.cos(yaw), abs_tol=1e-12)
+    assert main(["plan", str(path), "--seed", "1", "--time", "2"]) == 0
+    assert "solved by kc-rrtconnect" in capsys.readouterr().out

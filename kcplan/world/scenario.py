@@ -24,7 +24,7 @@ import yaml
 from numpy.typing import NDArray
 
 from kcplan.files import write_text_atomic
-from kcplan.geometry.pose import quaternion_matrix
+from kcplan.geometry.pose import quaternion_matrix, wrap_angle
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.world.mesh import read_mesh
 from kcplan.world.polygon import convex_pieces
@@ -258,8 +258,9 @@ class _Reader:
         angle = "yaw" if n == 2 else "quaternion"
         spec = self.mapping(value, where, ("position",), (angle,))
         position = self.vector(spec["position"], f"{where}.position", n)
-        if n == 2:
-            return np.append(position, self.number(spec.get("yaw", 0.0), f"{where}.yaw"))
+        if n == 2:  # OMPL's SO(2) holds [-pi, pi]: a yaw of 7.0 would be an invalid state
+            yaw = float(wrap_angle(self.number(spec.get("yaw", 0.0), f"{where}.yaw")))
+            return np.append(position, yaw)
         q = self.quaternion(spec.get("quaternion", [0.0, 0.0, 0.0, 1.0]), f"{where}.quaternion")
         return np.concatenate([position, q])
 
