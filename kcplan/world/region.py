@@ -48,11 +48,9 @@ class FreeRegion:
     def clearance(self) -> float:
         """Distance from the robot to every obstacle, never an overestimate; 0 when the
         robot touches one or is too close to tell."""
-        return (
-            float(min(self.clearances.min(), self.horizon))
-            if len(self.clearances)
-            else (self.horizon)
-        )
+        if not len(self.clearances):
+            return self.horizon
+        return float(min(self.clearances.min(), self.horizon))
 
     @property
     def size(self) -> int:
