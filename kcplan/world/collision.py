@@ -119,15 +119,13 @@ class CollisionWorld:
         self._half_height = float(max(a.max(), 1.0))
         self._objects: list[fcl.CollisionObject] = []
         self.owner: list[int] = []  # obstacle index of each FCL object
-        self._supports: list = []  # exact support function of each FCL object, or None
-        self._piece_of: dict[int, int] = {}  # id of an FCL geometry -> its object's index
+        # id of an FCL geometry -> the exact support function of its piece, or None
+        self._support_of: dict[int, object] = {}
         for ob in scenario.obstacles:
             parts = self._fcl_parts(ob)
-            supports = piece_supports(ob)
-            for (geom, tf), support in zip(parts, supports, strict=True):
-                self._piece_of[id(geom)] = len(self._objects)
+            for (geom, tf), support in zip(parts, piece_supports(ob), strict=True):
+                self._support_of[id(geom)] = support
                 self._objects.append(fcl.CollisionObject(geom, tf))
-                self._supports.append(support)
                 self.owner.append(ob.index)
         self._manager = fcl.DynamicAABBTreeCollisionManager()
         if self._objects:
@@ -204,8 +202,12 @@ class CollisionWorld:
         self.counters["collision_queries"] += 1
         if not self._objects:
             return False
+        return self._collides(self._robot)
+
+    def _collides(self, obj: fcl.CollisionObject) -> bool:
+        """One broad- and narrow-phase collision query of ``obj`` against the obstacles."""
         data = fcl.CollisionData()
-        self._manager.collide(self._robot, data, fcl.defaultCollisionCallback)
+        self._manager.collide(obj, data, fcl.defaultCollisionCallback)
         return bool(data.result.is_collision)
 
     def clearance(self, pose: ArrayLike) -> float:
@@ -272,7 +274,7 @@ class CollisionWorld:
                 piece, (p_robot, p_obstacle) = result.o2, result.nearest_points
             else:
                 piece, (p_obstacle, p_robot) = result.o1, result.nearest_points
-            support = self._supports[self._piece_of[id(piece)]]
+            support = self._support_of[id(piece)]
             direction = (p_robot - p_obstacle)[:n]
             length = math.sqrt(float(direction @ direction))
             if support is None or length == 0.0:
@@ -294,9 +296,7 @@ class CollisionWorld:
         c = np.zeros(3)
         c[: self.dimension] = np.asarray(center, dtype=float)[: self.dimension]
         ball = fcl.CollisionObject(fcl.Sphere(float(radius)), fcl.Transform(c))
-        data = fcl.CollisionData()
-        self._manager.collide(ball, data, fcl.defaultCollisionCallback)
-        return bool(data.result.is_collision)
+        return self._collides(ball)
 
     def sweep_core_collides(self, t1: ArrayLike, t2: ArrayLike, radius: float) -> bool:
         """Whether the capsule of ``radius`` around the segment ``t1 -> t2`` (centre
@@ -325,9 +325,7 @@ class CollisionWorld:
         norm = math.sqrt(w * w + qx * qx + qy * qy)
         q = np.array([w / norm, qx / norm, qy / norm, 0.0] if norm > 1e-9 else [0.0, 1.0, 0.0, 0.0])
         capsule = fcl.CollisionObject(fcl.Capsule(float(radius), length), fcl.Transform(q, centre))
-        data = fcl.CollisionData()
-        self._manager.collide(capsule, data, fcl.defaultCollisionCallback)
-        return bool(data.result.is_collision)
+        return self._collides(capsule)
 
     def in_collision_many(self, poses: ArrayLike) -> NDArray[np.bool_]:
         """:meth:`in_collision` for each row of ``poses`` (shape ``(k, 3 or 7)``)."""
