@@ -204,15 +204,25 @@ class EdgeCertifier:
         known = self.cache.validity(key)
         if known is not None:
             return known
-        grid = self._grid
-        if grid is None and self.occupancy:
-            grid = self._grid = CoreOccupancy(self.world)
+        grid = self._occupancy()
         if grid is not None and grid.blocked(p):
             self.counters["occupancy_rejections"] += 1
             self.cache.add_validity(key, False)
             return False
+        return self._collision_free(p, key)
+
+    def _occupancy(self) -> CoreOccupancy | None:
+        """The occupancy grid, built on first use (None when ``occupancy`` is off)."""
+        if self._grid is None and self.occupancy:
+            self._grid = CoreOccupancy(self.world)
+        return self._grid
+
+    def _collision_free(self, p: np.ndarray, key: bytes) -> bool:
+        """One collision query at a state neither the cache nor the grid knows; the result
+        is cached, and a colliding state's grid cell is learned."""
         self.counters["collision_queries"] += 1
         valid = not self.world.in_collision(p)
+        grid = self._grid
         if not valid and grid is not None:  # learn the cell for the next state there
             before = grid.queries
             grid.learn(p)
@@ -261,7 +271,7 @@ class EdgeCertifier:
         p1 = np.asarray(pose1, dtype=float)
         p2 = np.asarray(pose2, dtype=float)
         k1, k2 = p1.tobytes(), p2.tobytes()
-        cache, grid = self.cache, self._grid
+        cache, grid = self.cache, self._occupancy()
         if grid is not None and grid.blocked(p2):
             return self._reject("rejected_occupancy")
         g1, g2 = cache.guard(k1), cache.guard(k2)
@@ -271,7 +281,8 @@ class EdgeCertifier:
         tested = known is None and grid is not None
         if tested and grid.segment_blocked(p1, p2):
             return self._reject("rejected_occupancy")
-        if not (known or self.state_valid(p2, k2)):
+        # known False, or unknown (the grid was asked above) and colliding
+        if not (known or (known is None and self._collision_free(p2, k2))):
             return self._reject("rejected_end_state")
         edge = Edge(p1, p2, self.n)
         lo, hi = 0.0, 1.0
