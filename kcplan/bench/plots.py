@@ -38,7 +38,8 @@ def _planners(records: Sequence[dict]) -> list[str]:
 
 def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.PathLike) -> None:
     """Box plots of solve time and FCL queries per planner, over the solved runs of one
-    scenario (log scales; each box labelled with its solved count)."""
+    scenario (log scales; each box labelled with its solved count and, when stock
+    returned some, how many of those paths collide)."""
     runs = [r for r in records if r["scenario_name"] == scenario]
     planners = _planners(runs)
     fig, axes = plt.subplots(1, 2, figsize=(4 + 1.4 * len(planners), 4.2))
@@ -46,7 +47,7 @@ def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.Pa
         axes,
         (
             ("time to solution [s]", lambda r: r["time"]),
-            ("FCL queries (collision + distance)", lambda r: r["counters"]["fcl_queries"]),
+            ("FCL queries (collision, distance, region)", lambda r: r["counters"]["fcl_queries"]),
         ),
         strict=True,
     ):
@@ -55,13 +56,15 @@ def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.Pa
             mine = [r for r in runs if r["planner"] == planner]
             solved = [r for r in mine if r["solved"]]
             data.append([max(get(r), 1e-4) for r in solved] or [math.nan])
-            names.append(f"{planner}\n{len(solved)}/{len(mine)} solved")
+            colliding = sum(bool(r.get("collides")) for r in solved)
+            name = f"{planner}\n{len(solved)}/{len(mine)} solved"
+            names.append(name + (f"\n{colliding} colliding" if colliding else ""))
         box = ax.boxplot(data, patch_artist=True, widths=0.6)
         for i, (patch, planner) in enumerate(zip(box["boxes"], planners, strict=True)):
             patch.set_facecolor(_color(planner, i))
         for i, values in enumerate(data, start=1):
             ax.plot(np.full(len(values), i), values, ".", color="k", ms=3, alpha=0.5)
-        ax.set_xticks(range(1, len(names) + 1), names, fontsize=8)
+        ax.set_xticks(range(1, len(names) + 1), names, fontsize=8, rotation=30, ha="right")
         ax.set_yscale("log")
         ax.set_ylabel(label)
         ax.grid(axis="y", alpha=0.3)

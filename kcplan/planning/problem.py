@@ -52,8 +52,8 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
         _KC,
-        description="stock RRT-Connect, edges certified by free-region planes and KC "
-        "polytopes (exact); OMPL's default range (0.2 x the space's maximum extent)",
+        description="stock RRT-Connect, edges certified by free-region planes (exact); "
+        "OMPL's default range (0.2 x the space's maximum extent)",
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
