@@ -8,8 +8,8 @@ runs (OMPL path length after simplification). A kc planner's *twin* is the stock
 it wraps (``kc-prm`` -> ``prm``), or its 0.1 % resolution version (``prm-fine``) when
 only that ran; its *ca twin* is the same planner with the plain clearance-ball
 certificate (``kc-prm`` -> ``ca-prm``, the ablation baseline). Ratios are twin / kc, so
-above 1 means kc wins. ``covered_*`` columns are the share of the edge parameter each
-certificate covered (medians over runs).
+above 1 means kc wins. ``share_*`` columns are the share of the certified edge parameter
+each certificate won (from the ``kc_covered_*`` counters; medians over runs).
 """
 
 from __future__ import annotations
