@@ -133,7 +133,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             continue
         print(
             f"ok      {path}: {s.name}, {s.dimension}D, {len(s.obstacles)} obstacles, "
-            f"robot {s.semi_axes.tolist()}"
+            f"robot {s.robot.describe()}"
         )
     if failed:
         print(f"{failed} of {len(args.scenarios)} scenario files are invalid", file=sys.stderr)
@@ -376,7 +376,9 @@ def _cmd_import(args: argparse.Namespace) -> int:
 
             if not Path(args.resources).is_dir():
                 raise MapImportError(f"{args.resources}: expected HRM's resources folder")
-            data = import_hrm(args.resources, args.map, args.dimension, out, args.inflation)
+            data = import_hrm(
+                args.resources, args.map, args.dimension, out, args.inflation, args.robot
+            )
         else:
             from kcplan.maps.movingai import import_movingai
 
@@ -391,7 +393,7 @@ def _cmd_import(args: argparse.Namespace) -> int:
     dump_scenario(data, out)
     print(
         f"{out}: {scenario.name}, {scenario.dimension}D, {len(data['obstacles'])} obstacles, "
-        f"robot {[float(a) for a in scenario.semi_axes]}"
+        f"robot {scenario.robot.describe()}"
     )
     print(data["description"])
     return 0
@@ -673,14 +675,20 @@ def build_parser() -> argparse.ArgumentParser:
     q = kinds.add_parser(
         "hrm",
         help="a Highway RoadMap map (CSV, github.com/ChirikjianLab/hrm)",
-        description="Convert an HRM map with its single-body robot. Superellipses become "
-        "circumscribed polygons (outer approximations), the arena is kept by walls outside "
-        "its inscribed polygon (3D: a mesh surface and an inscribed box for the centre); "
-        "the bound on the geometric error is in the scenario's description.",
+        description="Convert an HRM map with one of HRM's robots (every body kept, rigid). "
+        "Superellipses become circumscribed polygons, superquadrics circumscribed convex "
+        "polytopes (outer approximations); the arena is kept by walls outside its inscribed "
+        "polygon (3D: a mesh surface and an inscribed box for the robot's origin); the "
+        "bound on the geometric error is in the scenario's description.",
     )
     q.add_argument("resources", metavar="RESOURCES_DIR", help="HRM's resources folder")
     q.add_argument("--map", required=True, help="map name, e.g. ellipse_maze or maze")
     q.add_argument("--dimension", type=int, choices=(2, 3), default=2, help="2 (default) or 3")
+    q.add_argument(
+        "--robot",
+        help="HRM robot: 2D NAO_silhouette, S_shape, rabbit, single_body (default); "
+        "3D chair, rabbit (default), rabbit2, snake, tree",
+    )
     q.add_argument("--inflation", type=_positive_float, default=0.1, help="guard inflation")
     q.add_argument("-o", "--output", required=True, metavar="SCENARIO.yaml")
     q.set_defaults(handler=_cmd_import)

@@ -18,6 +18,7 @@ from scipy.spatial import ConvexHull  # noqa: E402
 
 from kcplan.files import atomic_output  # noqa: E402
 from kcplan.geometry.pose import Edge, pose_frame  # noqa: E402
+from kcplan.geometry.robot import Robot  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
 from kcplan.world.scenario import Scenario  # noqa: E402
 
@@ -119,6 +120,15 @@ def _box_faces(center, R, half) -> list[np.ndarray]:
     return [V[q] for q in quads]
 
 
+def _bodies(robot: Robot, pose, inflation: float = 0.0):
+    """``(R, t, semi_axes)`` of every body of ``robot`` at ``pose``, each scaled by
+    ``1 + inflation`` about its own centre."""
+    n = robot.dimension
+    for body, body_pose in zip(robot.bodies, robot.body_poses(pose), strict=True):
+        R, t = pose_frame(body_pose, n)
+        yield R, t, (1.0 + inflation) * body.semi_axes
+
+
 def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None) -> None:
     """Draw a scenario's obstacles, bounds, start and goal robots on ``ax``.
 
@@ -129,9 +139,9 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
     poses : sequence of pose vectors, optional
         Extra robot poses to draw (e.g. along a path), in the flat pose layout.
     guards : float, optional
-        Also outline the guard ``(1 + guards) a`` at start and goal.
+        Also outline the guard ``(1 + guards) a`` of every body at start and goal.
     """
-    n, a = scenario.dimension, scenario.semi_axes
+    n, robot = scenario.dimension, scenario.robot
     low, high = scenario.bounds
     if n == 2:
         from matplotlib.patches import Polygon, Rectangle
@@ -156,26 +166,28 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
                     )
                 )
         for pose in poses:
-            R, t = pose_frame(pose, 2)
-            ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
+            for R, t, a in _bodies(robot, pose):
+                ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
         for pose, color, label in (
             (scenario.start, "tab:green", "start"),
             (scenario.goal, "tab:red", "goal"),
         ):
-            R, t = pose_frame(pose, 2)
-            ax.add_patch(
-                Polygon(
-                    _ellipse_outline(t, R, a),
-                    closed=True,
-                    fc=color,
-                    alpha=0.5,
-                    ec=color,
-                    label=label,
+            for k, (R, t, a) in enumerate(_bodies(robot, pose)):
+                ax.add_patch(
+                    Polygon(
+                        _ellipse_outline(t, R, a),
+                        closed=True,
+                        fc=color,
+                        alpha=0.5,
+                        ec=color,
+                        label=label if k == 0 else None,
+                    )
                 )
-            )
-            ax.plot(*np.array([t, t + R[:, 0] * a[0]]).T, color="k", lw=0.8)
-            if guards:
-                ax.plot(*_ellipse_outline(t, R, (1 + guards) * a).T, color=color, ls=":", lw=0.8)
+                if guards:
+                    outline = _ellipse_outline(t, R, (1 + guards) * a)
+                    ax.plot(*outline.T, color=color, ls=":", lw=0.8)
+            R, t = pose_frame(pose, 2)  # the robot's heading, from its origin
+            ax.plot(*np.array([t, t + R[:, 0] * robot.reach]).T, color="k", lw=0.8)
         pad = 0.03 * (high - low).max()
         ax.set_xlim(low[0] - pad, high[0] + pad)
         ax.set_ylim(low[1] - pad, high[1] + pad)
@@ -188,7 +200,7 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
         if ob.kind == "box":
             faces += _box_faces(ob.center, ob.rotation, ob.extents)
             colors += ["0.6"] * 6
-        elif ob.kind == "mesh":
+        elif ob.kind in ("mesh", "convex"):
             faces += list(ob.vertices[ob.triangles])
             colors += ["tab:brown"] * len(ob.triangles)
         else:
@@ -203,11 +215,12 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             Poly3DCollection(faces, facecolors=colors, edgecolors="0.3", linewidths=0.2, alpha=0.35)
         )
     for pose in poses:
-        R, t = pose_frame(pose, 3)
-        ax.plot_wireframe(*_ellipsoid_surface(t, R, a, 8), color="tab:blue", lw=0.3, alpha=0.5)
+        for R, t, a in _bodies(robot, pose):
+            surface = _ellipsoid_surface(t, R, a, 8)
+            ax.plot_wireframe(*surface, color="tab:blue", lw=0.3, alpha=0.5)
     for pose, color in ((scenario.start, "tab:green"), (scenario.goal, "tab:red")):
-        R, t = pose_frame(pose, 3)
-        ax.plot_surface(*_ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
+        for R, t, a in _bodies(robot, pose):
+            ax.plot_surface(*_ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
     corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
     for i in range(8):
         for j in range(i + 1, 8):
@@ -278,21 +291,12 @@ def plot_path(
         P = np.asarray(states)
         ax.plot(*P[:, :n].T, color="tab:blue", lw=1.2, marker="o", ms=3)
     for pose, eps in guards or []:
-        R, t = pose_frame(pose, n)
-        if n == 2:
-            ax.plot(
-                *_ellipse_outline(t, R, (1 + eps) * scenario.semi_axes).T,
-                color="tab:orange",
-                ls="--",
-                lw=0.6,
-            )
-        else:
-            ax.plot_wireframe(
-                *_ellipsoid_surface(t, R, (1 + eps) * scenario.semi_axes, 6),
-                color="tab:orange",
-                lw=0.3,
-                alpha=0.5,
-            )
+        for R, t, a in _bodies(scenario.robot, pose, eps):
+            if n == 2:
+                ax.plot(*_ellipse_outline(t, R, a).T, color="tab:orange", ls="--", lw=0.6)
+            else:
+                surface = _ellipsoid_surface(t, R, a, 6)
+                ax.plot_wireframe(*surface, color="tab:orange", lw=0.3, alpha=0.5)
     extra = f", {len(guards)} guards (dashed)" if guards else ""
     ax.set_title((title or scenario.name) + extra, fontsize=9)
     save_figure(fig, path)

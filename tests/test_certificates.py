@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from kcplan.geometry.pose import Edge
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
-from kcplan.planning.guard import Guard, GuardCache
+from kcplan.planning.guard import BodyGuard, Guard, GuardCache
 from kcplan.world import CollisionWorld, parse_scenario
 from kcplan.world.clutter import random_pose, random_scenario
 from kcplan.world.occupancy import CoreOccupancy
@@ -91,7 +91,7 @@ def test_region_query_lists_every_piece_within_the_horizon(n):
         for _ in range(30):
             pose = random_pose(rng, n, -18, 18)
             horizon = float(rng.uniform(0.5, 6))
-            region = world.free_region(pose, horizon)
+            (region,) = world.free_regions(pose, horizon)
             exact = world.clearance(pose)
             if exact <= 0.0:
                 assert region.clearance == 0.0
@@ -100,7 +100,7 @@ def test_region_query_lists_every_piece_within_the_horizon(n):
             world._place(pose)
             import fcl
 
-            distances = [fcl.distance(world._robot, o) for o in world._objects]
+            distances = [fcl.distance(world._bodies[0], o) for o in world._objects]
             assert region.size >= sum(d < horizon for d in distances)
             assert region.clearance <= exact + 1e-9  # never an overestimate
             if exact < horizon:
@@ -120,11 +120,11 @@ def test_planes_contain_their_piece_and_the_slack_never_exceeds_the_distance(n):
         world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
         for _ in range(40):
             pose = random_pose(rng, n, -18, 18)
-            region = world.free_region(pose, 5.0)
-            if region.clearance <= 0.0 or region.size == 0:
+            regions = world.free_regions(pose, 5.0)
+            if regions[0].clearance <= 0.0 or regions[0].size == 0:
                 continue
-            guard = Guard.from_region(pose, region, a, 0.0)
-            for sigma, d in zip(guard.slacks, guard.clearances, strict=True):
+            guard = Guard.from_regions(pose, regions, world.robot, 0.0)
+            for sigma, d in zip(guard.slacks, guard.piece_clearances, strict=True):
                 if np.isfinite(sigma):
                     raw = (d + world.clearance_atol) / (1 - 2e-3)  # FCL's own distance
                     assert sigma <= raw + 1e-7
@@ -165,8 +165,8 @@ def test_reach_of_every_certificate_is_collision_free(n, certificate):
             edge = Edge(p1, p2, n)
             m = float(rng.uniform(0, 1))
             g = edge.pose(m)
-            region = world.free_region(g, 4.0)
-            guard = Guard.from_region(g, region, a, world.clearance_atol)
+            regions = world.free_regions(g, 4.0)
+            guard = Guard.from_regions(g, regions, world.robot, world.clearance_atol)
             if guard.clearance <= 0.0:
                 continue
             minus, plus = cert.reach(guard, edge, m)
@@ -180,10 +180,11 @@ def test_region_certifies_motion_along_a_wall_for_free():
     """In a corridor 1 wider than the robot, the ball covers about 2 x 0.5 of motion;
     the planes cover the whole 40-long stretch (up to the horizon)."""
     world = corridor_world()
-    a = world.semi_axes
+    a = world.robot.semi_axes
     p1, p2 = np.array([35.0, 30.0, 0.0]), np.array([85.0, 30.0, 0.0])
     edge = Edge(p1, p2, 2)
-    guard = Guard.from_region(p1, world.free_region(p1, 50.0), a, world.clearance_atol)
+    regions = world.free_regions(p1, 50.0)
+    guard = Guard.from_regions(p1, regions, world.robot, world.clearance_atol)
     _, ball = ClearanceBall(a).reach(guard, edge, 0.0)
     _, planes = FreeRegionPlanes(a).reach(guard, edge, 0.0)
     assert ball == pytest.approx(0.5 / 50, rel=0.01)
@@ -198,7 +199,7 @@ def test_planes_of_a_mesh_piece_fall_back_to_its_clearance():
     """A piece without a plane (``-inf`` slack) only covers what its clearance ball does:
     a zero direction row can never give an infinite reach."""
     a = np.array([2.0, 1.0])
-    guard = Guard(np.zeros(3), 0.5, ((0.0, 0.0, 0.0, -math.inf, 0.5),), 10.0)
+    guard = Guard(np.zeros(3), (BodyGuard(0.5, ((0.0, 0.0, 0.0, -math.inf, 0.5),), 10.0),))
     edge = Edge(np.zeros(3), np.array([4.0, 0.0, 0.0]), 2)
     assert FreeRegionPlanes(a).reach(guard, edge, 0.0) == (0.125, 0.125)
 
@@ -210,7 +211,7 @@ def test_guard_cache_is_bounded_and_keyed_by_exact_pose():
     cache = GuardCache(max_entries=100)
     poses = np.random.default_rng(0).normal(size=(1000, 3))
     for p in poses:
-        cache.add_guard(p.tobytes(), Guard(p, 1.0))
+        cache.add_guard(p.tobytes(), Guard.of_clearances(p, [1.0]))
     assert len(cache) <= 100
     last = poses[-1]
     assert cache.guard(last.tobytes()) is not None
@@ -279,7 +280,7 @@ def test_an_exception_in_the_validator_is_raised_after_solve_not_through_ompl():
     from kcplan.world import load_scenario
 
     class BrokenWorld(CollisionWorld):
-        def free_region(self, pose, horizon):
+        def free_regions(self, pose, horizon):
             raise RuntimeError("region query failed")
 
     root = Path(__file__).resolve().parents[1]

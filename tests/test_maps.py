@@ -151,7 +151,7 @@ def test_every_hrm_map_converts_and_validates(name, dimension, tmp_path, capsys)
             local *= rng.uniform(0.2, 1.0, (60, 1)) ** 0.5
             R = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
             pts = local @ R.T + c
-            tiny = CollisionWorld(scenario, semi_axes=[1e-6, 1e-6])
+            tiny = CollisionWorld(scenario, [1e-6, 1e-6])
             assert all(tiny.in_collision(np.array([x, y, 0.0])) for x, y in pts)
     assert len(data["obstacles"]) >= len(obstacles)
     del world
@@ -162,7 +162,7 @@ def test_hrm_arena_keeps_the_robot_inside(tmp_path):
     out = tmp_path / "sparse.yaml"
     assert main(["import", "hrm", str(HRM), "--map", "ellipse_sparse", "-o", str(out)]) == 0
     scenario = load_scenario(out)
-    tiny = CollisionWorld(scenario, semi_axes=[1e-6, 1e-6])
+    tiny = CollisionWorld(scenario, [1e-6, 1e-6])
     a, e = np.array([50.0, 40.0]), 0.1
     rng = np.random.default_rng(4)
     pts = rng.uniform([-60, -50], [60, 50], (3000, 2))
@@ -253,7 +253,7 @@ def test_every_moving_ai_map_converts_and_validates(name, tmp_path, capsys):
     grid = read_grid(MAPF / f"{name}.map")
     H, W = grid.shape
     # every blocked cell centre is inside an obstacle, every free cell centre is not
-    tiny = CollisionWorld(scenario, semi_axes=[1e-6, 1e-6])
+    tiny = CollisionWorld(scenario, [1e-6, 1e-6])
     for r in range(0, H, max(1, H // 32)):
         for c in range(0, W, max(1, W // 32)):
             pose = np.array([c + 0.5, H - r - 0.5, 0.0])

@@ -252,6 +252,7 @@ def test_own_setup_example_runs():
     )
     assert proc.returncode == 0, proc.stderr
     assert "solved:" in proc.stdout and "validator counters" in proc.stdout
+    assert "verified: free" in proc.stdout  # two bodies, re-checked without gaps
     assert "leaked" not in proc.stderr
 
 

@@ -354,21 +354,26 @@ def test_mesh_obstacle(tmp_path):
 
 def test_counters_increase_once_per_query():
     world = world_2d([{"circle": {"center": [10, 0], "radius": 1}}])
-    zero = {"collision_queries": 0, "distance_queries": 0, "region_queries": 0, "region_pairs": 0}
+    zero = dict.fromkeys(
+        ("collision_queries", "distance_queries", "region_queries", "region_pairs", "body_queries"),
+        0,
+    )
     assert world.counters == zero
     world.in_collision([0, 0, 0])
-    assert world.counters == zero | {"collision_queries": 1, "distance_queries": 0}
+    assert world.counters == zero | {"collision_queries": 1, "body_queries": 1}
     world.clearance([0, 0, 0])
-    assert world.counters == zero | {"collision_queries": 1, "distance_queries": 1}
+    one_each = {"collision_queries": 1, "distance_queries": 1, "body_queries": 2}
+    assert world.counters == zero | one_each
     poses = np.zeros((7, 3))
     world.in_collision_many(poses)
     world.clearance_many(poses)
-    assert world.counters == zero | {"collision_queries": 8, "distance_queries": 8}
+    eight = zero | {"collision_queries": 8, "distance_queries": 8, "body_queries": 16}
+    assert world.counters == eight
     world.colliding_obstacles([0, 0, 0])  # diagnostics are not counted
-    assert world.counters == zero | {"collision_queries": 8, "distance_queries": 8}
+    assert world.counters == eight
+    assert world.body_query_counts == [16]
     world.reset_counters()
-    zero = {"collision_queries": 0, "distance_queries": 0, "region_queries": 0, "region_pairs": 0}
-    assert world.counters == zero
+    assert world.counters == zero and world.body_query_counts == [0]
 
 
 def test_empty_world_and_bad_pose():

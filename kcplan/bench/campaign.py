@@ -134,7 +134,7 @@ def campaign_metadata(
                 "name": s.name,
                 "file": str(Path(s.source).resolve()),
                 "dimension": s.dimension,
-                "semi_axes": [float(x) for x in s.semi_axes],
+                "robot": s.robot.describe(),
                 "description": s.description,
             }
             for s in scenarios

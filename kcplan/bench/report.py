@@ -90,7 +90,7 @@ def write_reports(
         props = {
             "scenario file": ("VARCHAR(1024)", scenario["file"]),
             "dimension": ("INTEGER", scenario["dimension"]),
-            "robot semi axes": ("VARCHAR(128)", " ".join(map(str, scenario["semi_axes"]))),
+            "robot": ("VARCHAR(128)", _robot_text(scenario)),
             "kcplan version": ("VARCHAR(32)", campaign["kcplan_version"]),
         }
         text = format_log(
@@ -127,3 +127,11 @@ def write_reports(
     plot_success_vs_budget(records, out / "plots" / "success_vs_budget.png")
     written["plot:success"] = out / "plots" / "success_vs_budget.png"
     return written
+
+
+def _robot_text(scenario: dict) -> str:
+    """The campaign's robot description (campaigns before multi-body robots stored the
+    semi-axes)."""
+    if "robot" in scenario:
+        return scenario["robot"]
+    return "semi axes " + " ".join(map(str, scenario["semi_axes"]))

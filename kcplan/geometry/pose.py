@@ -180,7 +180,7 @@ class Edge:
         self.translation_speed = math.sqrt(float(self.dt @ self.dt))  # |t2 - t1| per unit s
         if n == 2:
             self.yaw1 = float(p1[2])
-            turn = so2_difference(p1[2], p2[2])
+            turn = so2_difference(float(p1[2]), float(p2[2]))
             self.w = np.array([turn])
             self.rotation_speed = abs(turn)  # radians per unit s
             return

@@ -5,21 +5,24 @@ Robots With Ellipsoidal Components", IEEE T-RO 2022; github.com/ChirikjianLab/hr
 its maps as CSV in ``resources/2D`` and ``resources/3D`` (format in its
 ``resources/readme.md``): an arena and obstacles as superellipses ``a, b, e, cx, cy,
 theta`` (3D superquadrics ``a, b, c, e1, e2, cx, cy, cz, axis, angle``), robots as
-ellipses relative to a base body, and start/goal rows.
+ellipses/ellipsoids relative to a base body, and start/goal rows (superquadric settings
+add joint angles of HRM's articulated robots after the 7 pose columns; they are ignored,
+the robots are rigid here).
 
 Conversion (a path free in the converted map is free in the original):
 - obstacles with ``e = 1`` (ellipses, ellipsoids) are exact FCL primitives; other
   superellipses become the circumscribed polygon of 256 tangent lines, which contains
-  the shape (:mod:`kcplan.maps.superquadric`), 3D superquadrics (equal exponents) the
-  circumscribed polytope as a mesh;
+  the shape (:mod:`kcplan.maps.superquadric`), 3D superquadrics (any exponents
+  ``0 < e1, e2 < 2``) the circumscribed polytope of 1500 tangent planes as a ``convex``
+  obstacle (an FCL convex solid: a robot cannot hide inside it, as it could in a mesh);
 - the arena (the robot must stay inside it): in 2D the region outside the inscribed
   polygon of 512 boundary points is filled with convex wedge obstacles reaching past the
   bounds by more than the robot's size; in 3D the inscribed polytope's surface is a mesh
   obstacle written beside the YAML, and the bounds for the robot's centre are the box
   inscribed in the arena, so a robot that does not touch the surface is inside;
-- the robot is the single-body robot: in 2D ``robot_single_body_2D.csv``; in 3D HRM ships
-  only the multi-body rabbit, whose base ellipsoid (10, 5, 4) is used alone (multi-body
-  robots are out of scope for kcplan's single-ellipsoid validator).
+- the robot (``robot_{name}_{n}D.csv``; default ``single_body`` in 2D, ``rabbit`` in 3D)
+  keeps every body: row 1 is the base at the robot's origin, further rows are rigid
+  bodies relative to it (:mod:`kcplan.geometry.robot`).
 The geometric error of each approximation (an upper bound of the distance between the
 polygon or polytope and the true shape) is written into the scenario's description.
 """
@@ -33,18 +36,20 @@ from pathlib import Path
 
 import numpy as np
 
+from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.maps import MapImportError
 from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.world.mesh import write_stl
 
-__all__ = ["HRM_MAPS", "hrm_maps", "import_hrm"]
+__all__ = ["HRM_MAPS", "HRM_ROBOTS", "hrm_maps", "hrm_robots", "import_hrm"]
 
 ROUNDING_MARGIN = 1e-6
 """Outer shapes are scaled by ``1 + margin``, inner ones by ``1 - margin`` (about their own
 centre) before writing, so rounding to 9 decimals in YAML or to float32 in STL cannot move
 a tangent edge or face across the true shape."""
 OBSTACLE_NORMALS = 256
+OBSTACLE_NORMALS_3D = 1500
 ARENA_NORMALS_2D = 512
 ARENA_NORMALS_3D = 1500
 
@@ -55,12 +60,32 @@ HRM_MAPS = {
         "ellipse_gym_maze",
         "ellipse_maze",
         "ellipse_sparse",
+        "superellipse_NAO_lab",
         "superellipse_cluttered",
         "superellipse_maze1",
+        "superellipse_maze2",
+        "superellipse_maze3",
+        "superellipse_sparse",
     ),
-    3: ("ellipsoid_cluttered", "ellipsoid_maze", "ellipsoid_sparse"),
+    3: (
+        "ellipsoid_cluttered",
+        "ellipsoid_maze",
+        "ellipsoid_sparse",
+        "superquadrics_cluttered",
+        "superquadrics_home",
+        "superquadrics_maze",
+        "superquadrics_narrow",
+        "superquadrics_sparse",
+        "superquadrics_tunnel",
+    ),
 }
 """The maps of HRM's resources (commit 435b943), by dimension."""
+HRM_ROBOTS = {
+    2: ("NAO_silhouette", "S_shape", "rabbit", "single_body"),
+    3: ("chair", "rabbit", "rabbit2", "snake", "tree"),
+}
+"""The robots of HRM's resources, by dimension (snake and tree as rigid bodies)."""
+DEFAULT_ROBOT = {2: "single_body", 3: "rabbit"}
 
 
 def hrm_maps(resources: str | os.PathLike, dimension: int) -> list[str]:
@@ -70,7 +95,16 @@ def hrm_maps(resources: str | os.PathLike, dimension: int) -> list[str]:
     return sorted(p.name[4 : -len(suffix)] for p in folder.glob(f"env_*{suffix}"))
 
 
-def _rows(path: Path, width: int) -> np.ndarray:
+def hrm_robots(resources: str | os.PathLike, dimension: int) -> list[str]:
+    """Robot names present in ``RESOURCES/{2D,3D}`` (``robot_{name}_{n}D.csv``)."""
+    folder = Path(resources) / f"{dimension}D"
+    suffix = f"_{dimension}D.csv"
+    return sorted(p.name[6 : -len(suffix)] for p in folder.glob(f"robot_*{suffix}"))
+
+
+def _rows(path: Path, width: int, extra: bool = False) -> np.ndarray:
+    """The numeric rows of an HRM CSV file, ``width`` columns each (``extra``: at least
+    ``width``, the first ``width`` kept)."""
     if not path.is_file():
         raise MapImportError(f"{path}: cannot read the file: no such file")
     rows = []
@@ -84,9 +118,11 @@ def _rows(path: Path, width: int) -> np.ndarray:
                 raise MapImportError(
                     f"{path}: row {i}: expected {width} numbers, got {row}"
                 ) from None
-            if len(values) != width or not all(math.isfinite(v) for v in values):
-                raise MapImportError(f"{path}: row {i}: expected {width} finite numbers, got {row}")
-            rows.append(values)
+            wrong = len(values) < width if extra else len(values) != width
+            if wrong or not all(math.isfinite(v) for v in values):
+                what = f"at least {width}" if extra else f"{width}"
+                raise MapImportError(f"{path}: row {i}: expected {what} finite numbers, got {row}")
+            rows.append(values[:width])
     if not rows:
         raise MapImportError(f"{path}: expected at least one row, got an empty file")
     return np.array(rows)
@@ -125,8 +161,10 @@ def import_hrm(
     dimension: int,
     output: str | os.PathLike,
     inflation: float = 0.1,
+    robot: str | None = None,
 ) -> dict:
-    """Convert one HRM map into a scenario dict (and, in 3D, write the arena mesh).
+    """Convert one HRM map with one of HRM's robots into a scenario dict (and, in 3D,
+    write the arena mesh).
 
     Parameters
     ----------
@@ -140,6 +178,8 @@ def import_hrm(
         as ``<stem>.arena.stl`` (atomically) and referenced relatively.
     inflation : float
         The robot's guard inflation recorded in the scenario.
+    robot : str, optional
+        HRM's robot (:data:`HRM_ROBOTS`); default ``single_body`` (2D), ``rabbit`` (3D).
 
     Returns
     -------
@@ -151,28 +191,76 @@ def import_hrm(
         raise MapImportError(f"--dimension: expected 2 or 3, got {dimension}")
     name = _resolve(root, name, dimension)
     folder = root / f"{dimension}D"
+    robot = DEFAULT_ROBOT[dimension] if robot is None else robot
+    robots = hrm_robots(root, dimension)
+    if robot not in robots:
+        choices = ", ".join(robots) or f"none found in {folder}"
+        raise MapImportError(
+            f"--robot: unknown robot {robot!r} for dimension {dimension}; expected one of {choices}"
+        )
     if dimension == 2:
-        return _import_2d(folder, name, inflation)
-    return _import_3d(folder, name, Path(output), inflation)
+        return _import_2d(folder, name, robot, inflation)
+    return _import_3d(folder, name, robot, Path(output), inflation)
 
 
-def _read_map(folder: Path, name: str, n: int):
-    """Robot row, arena row, obstacle file and rows, start/goal rows of one map."""
+def _read_map(folder: Path, name: str, robot: str, n: int):
+    """Robot spec and description, arena row, obstacle file and rows, start/goal rows."""
     shape, pose = (6, 3) if n == 2 else (12, 7)  # CSV widths (HRM's resources/readme.md)
-    robot = "robot_single_body_2D.csv" if n == 2 else "robot_rabbit_3D.csv"
     obstacles = folder / f"env_{name}_{n}D_obstacle.csv"
     return (
-        _rows(folder / robot, shape)[0],
+        *_robot(folder / f"robot_{robot}_{n}D.csv", robot, n),
         _rows(folder / f"env_{name}_{n}D_arena.csv", shape)[0],
         obstacles,
         _rows(obstacles, shape),
-        _rows(folder / f"setting_{name}_{n}D.csv", pose),
+        _rows(folder / f"setting_{name}_{n}D.csv", pose, extra=True),
     )
 
 
-def _import_2d(folder: Path, name: str, inflation: float) -> dict:
-    robot, arena, obstacles_csv, rows, setting = _read_map(folder, name, 2)
-    semi_axes = robot[:2]
+def _robot(path: Path, name: str, n: int) -> tuple[dict, str, float]:
+    """The scenario's ``robot`` fields (without inflation), a description, and the
+    robot's reach (largest distance of a robot point from its origin)."""
+    rows = _rows(path, 6 if n == 2 else 12)
+    if len(rows) > MAX_BODIES:
+        raise MapImportError(f"{path}: expected at most {MAX_BODIES} bodies, got {len(rows)}")
+    bodies = []
+    for i, row in enumerate(rows, start=1):
+        axes = row[:n]
+        exponents = row[2:3] if n == 2 else row[3:5]
+        if not (axes > 0).all() or not np.all(exponents == 1.0):
+            raise MapImportError(
+                f"{path}: row {i}: expected an ellipse/ellipsoid (positive semi-axes, "
+                f"exponents 1), got {row.tolist()}"
+            )
+        if n == 2:
+            body = {"semi_axes": _round(axes), "position": _round(row[3:5]), "yaw": float(row[5])}
+        else:
+            body = {
+                "semi_axes": _round(axes),
+                "position": _round(row[5:8]),
+                "quaternion": _round(_axis_angle_quaternion(row[8:11], row[11])),
+            }
+        bodies.append(body)
+    spec = {"bodies": bodies}
+    robot = Robot(
+        [
+            Body(np.array(b["semi_axes"]), np.array([*b["position"], b["yaw"]]))
+            if n == 2
+            else Body(np.array(b["semi_axes"]), np.array(b["position"] + b["quaternion"]))
+            for b in bodies
+        ]
+    )
+    if robot.is_single:
+        spec = {"semi_axes": bodies[0]["semi_axes"]}
+    shape = "ellipse" if n == 2 else "ellipsoid"
+    sizes = "; ".join(" x ".join(f"{v:g}" for v in b["semi_axes"]) for b in bodies)
+    text = f"Robot: HRM's {name}, {len(bodies)} {shape}{'s' * (len(bodies) > 1)} ({sizes})."
+    return spec, text, robot.reach
+
+
+def _import_2d(folder: Path, name: str, robot_name: str, inflation: float) -> dict:
+    robot, robot_text, reach, arena, obstacles_csv, rows, setting = _read_map(
+        folder, name, robot_name, 2
+    )
     obstacles, worst = [], 0.0
     for i, (a, b, e, cx, cy, theta) in enumerate(rows, start=1):
         if not 0 < e < 2 or a <= 0 or b <= 0:
@@ -192,10 +280,10 @@ def _import_2d(folder: Path, name: str, inflation: float) -> dict:
         worst = max(worst, bp.error)
         world = (1 + ROUNDING_MARGIN) * bp.outer @ exp_rotation([theta], 2).T + [cx, cy]
         obstacles.append({"polygon": {"vertices": [_round(v) for v in world]}})
-    walls, arena_error, low, high = _arena_walls_2d(arena, float(semi_axes.max()))
+    walls, arena_error, low, high = _arena_walls_2d(arena, reach)
     description = (
         f"HRM map {name} (2D), imported from github.com/ChirikjianLab/hrm (GPL-3.0 data). "
-        f"Robot: single_body {semi_axes[0]:g} x {semi_axes[1]:g}. "
+        f"{robot_text} "
         + (
             f"Superellipse obstacles as circumscribed {OBSTACLE_NORMALS}-gons (within "
             f"{worst:.3g} of the true shape); "
@@ -206,11 +294,11 @@ def _import_2d(folder: Path, name: str, inflation: float) -> dict:
         f"its inscribed {ARENA_NORMALS_2D}-gon (within {arena_error:.3g})."
     )
     return {
-        "name": f"hrm_{name}_2d",
+        "name": f"hrm_{name}_{robot_name}_2d",
         "description": description,
         "dimension": 2,
         "bounds": {"low": _round(low), "high": _round(high)},
-        "robot": {"semi_axes": _round(semi_axes), "inflation": inflation},
+        "robot": robot | {"inflation": inflation},
         "start": {"position": _round(setting[0, :2]), "yaw": float(setting[0, 2])},
         "goal": {"position": _round(setting[1, :2]), "yaw": float(setting[1, 2])},
         "obstacles": obstacles + walls,
@@ -232,20 +320,20 @@ def _arena_walls_2d(arena: np.ndarray, robot_size: float):
     return walls, bp.error, world.min(axis=0), world.max(axis=0)
 
 
-def _import_3d(folder: Path, name: str, output: Path, inflation: float) -> dict:
-    robot, arena, obstacles_csv, rows, setting = _read_map(folder, name, 3)
-    semi_axes = robot[:3]
+def _import_3d(folder: Path, name: str, robot_name: str, output: Path, inflation: float) -> dict:
+    robot, robot_text, _, arena, obstacles_csv, rows, setting = _read_map(
+        folder, name, robot_name, 3
+    )
     obstacles, worst = [], 0.0
-    stem = output.name.removesuffix(".yaml").removesuffix(".yml")
     for i, row in enumerate(rows, start=1):
         abc, (e1, e2), centre, axis, angle = row[:3], row[3:5], row[5:8], row[8:11], row[11]
-        if e1 != e2 or not 0 < e1 < 2:
+        if not (0 < e1 < 2 and 0 < e2 < 2):
             raise MapImportError(
-                f"{obstacles_csv}: row {i}: expected equal exponents 0 < e1 = e2 < 2, "
-                f"got {e1:g}, {e2:g}"
+                f"{obstacles_csv}: row {i}: expected exponents 0 < e1, e2 < 2 (a convex "
+                f"superquadric), got {e1:g}, {e2:g}"
             )
         quaternion = _axis_angle_quaternion(axis, angle)
-        if e1 == 1.0:
+        if e1 == e2 == 1.0:
             obstacles.append(
                 {
                     "ellipsoid": {
@@ -256,13 +344,19 @@ def _import_3d(folder: Path, name: str, output: Path, inflation: float) -> dict:
                 }
             )
             continue
-        bp = bounding_polytopes(abc, e1, ARENA_NORMALS_3D)
+        bp = bounding_polytopes(abc, (e1, e2), OBSTACLE_NORMALS_3D)
         worst = max(worst, bp.error)
-        mesh = f"{stem}.obstacle{i}.stl"
-        write_stl(output.parent / mesh, (1 + ROUNDING_MARGIN) * bp.outer, bp.outer_faces)
+        vertices = [_round(v) for v in (1 + ROUNDING_MARGIN) * bp.outer]
         obstacles.append(
-            {"mesh": {"file": mesh, "position": _round(centre), "quaternion": _round(quaternion)}}
+            {
+                "convex": {
+                    "vertices": vertices,
+                    "position": _round(centre),
+                    "quaternion": _round(quaternion),
+                }
+            }
         )
+    stem = output.name.removesuffix(".yaml").removesuffix(".yml")
     abc, (e1, e2), centre, axis, angle = arena[:3], arena[3:5], arena[5:8], arena[8:11], arena[11]
     if e1 != e2 or not 0 < e1 < 2:
         raise MapImportError(
@@ -290,23 +384,23 @@ def _import_3d(folder: Path, name: str, output: Path, inflation: float) -> dict:
     quats = [_axis_angle_quaternion(r[3:6], r[6]) for r in setting]
     description = (
         f"HRM map {name} (3D), imported from github.com/ChirikjianLab/hrm (GPL-3.0 data). "
-        f"Robot: the base ellipsoid {semi_axes[0]:g} x {semi_axes[1]:g} x {semi_axes[2]:g} "
-        f"of HRM's rabbit (its other bodies are left out). Arena {abc[0]:g} x {abc[1]:g} x "
+        f"{robot_text} Arena {abc[0]:g} x {abc[1]:g} x "
         f"{abc[2]:g} (e = {e1:g}) as the surface of its inscribed polytope (within "
         f"{bp.error:.3g}), robot centre confined to the box inside it"
         + (
-            f"; superquadric obstacles as circumscribed polytopes (within {worst:.3g})"
+            f"; superquadric obstacles as circumscribed convex polytopes of "
+            f"{OBSTACLE_NORMALS_3D} planes (within {worst:.3g})"
             if worst
             else ""
         )
         + "."
     )
     return {
-        "name": f"hrm_{name}_3d",
+        "name": f"hrm_{name}_{robot_name}_3d",
         "description": description,
         "dimension": 3,
         "bounds": {"low": _round(centre - inner_box), "high": _round(centre + inner_box)},
-        "robot": {"semi_axes": _round(semi_axes), "inflation": inflation},
+        "robot": robot | {"inflation": inflation},
         "start": {"position": _round(setting[0, :3]), "quaternion": _round(quats[0])},
         "goal": {"position": _round(setting[1, :3]), "quaternion": _round(quats[1])},
         "obstacles": obstacles,

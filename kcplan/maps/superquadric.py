@@ -18,8 +18,9 @@ Error bound: the shape lies between the two, so both are within
 a convex set is a convex function, so its maximum over the outer polytope is at a vertex).
 In 2D, ``dist(v, inner)`` is at most the distance from the corner ``v`` of two
 consecutive tangent lines to the chord between their support points (the arc between
-them lies in that triangle); in 3D it is computed exactly, as the distance from ``v`` to
-the nearest triangle of the inner hull. :func:`bounding_polytopes` returns that number.
+them lies in that triangle); in 3D it is bounded by the distance from ``v`` to
+the nearest of the inner hull's triangles whose planes it lies farthest outside of (a
+subset: an upper bound of the distance). :func:`bounding_polytopes` returns that number.
 """
 
 from __future__ import annotations
@@ -28,7 +29,9 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import ConvexHull, HalfspaceIntersection
+from scipy.spatial import HalfspaceIntersection
+
+from kcplan.world.mesh import convex_hull
 
 __all__ = [
     "superquadric_level",
@@ -37,6 +40,7 @@ __all__ = [
     "bounding_polytopes",
     "BoundingPolytopes",
     "point_triangle_distance",
+    "hull_distance_bound",
 ]
 
 
@@ -46,14 +50,43 @@ def _exponent(e: float) -> float:
     return 2.0 / e
 
 
-def superquadric_level(points: ArrayLike, semi_axes: ArrayLike, e: float) -> NDArray:
-    """``sum |x_i / a_i|^{2/e}`` for local points (k, n): <= 1 inside, 1 on the boundary."""
-    p = _exponent(e)
+def _exponents(e: float | tuple[float, float], n: int) -> tuple[float, float]:
+    """``(p1, p2) = (2 / e1, 2 / e2)``: one exponent ``e`` means ``e1 = e2 = e``."""
+    e1, e2 = (e, e) if np.ndim(e) == 0 else tuple(e)
+    if n == 2 and e1 != e2:
+        raise ValueError(f"exponent: a superellipse has one exponent, got {e1}, {e2}")
+    return _exponent(e1), _exponent(e2)
+
+
+def superquadric_level(
+    points: ArrayLike, semi_axes: ArrayLike, e: float | tuple[float, float]
+) -> NDArray:
+    """``(|x/a|^{p2} + |y/b|^{p2})^{p1/p2} + |z/c|^{p1}`` (``p = 2/e``) for local points
+    ``(k, n)``: <= 1 inside, 1 on the boundary (2D: ``|x/a|^p + |y/b|^p``)."""
     y = np.abs(np.asarray(points, dtype=float) / np.asarray(semi_axes, dtype=float))
-    return (y**p).sum(axis=-1)
+    p1, p2 = _exponents(e, y.shape[-1])
+    if y.shape[-1] == 2:
+        return (y**p1).sum(axis=-1)
+    return ((y[..., :2] ** p2).sum(axis=-1)) ** (p1 / p2) + y[..., 2] ** p1
 
 
-def support_points(normals: ArrayLike, semi_axes: ArrayLike, e: float) -> tuple[NDArray, NDArray]:
+def _holder(m: NDArray, p: float) -> tuple[NDArray, NDArray]:
+    """For rows ``m`` (k, d): the point ``y`` of the unit ``p``-norm ball maximising
+    ``m . y`` and the maximum, the dual norm ``|m|_q`` (zero rows: ``y = 0``)."""
+    q = p / (p - 1.0)
+    mag = np.abs(m)
+    # |m|_q with the largest entry factored out: |m_i|^q underflows for q near 1 and tiny m
+    top = mag.max(axis=1, keepdims=True)
+    safe = np.where(top > 0.0, top, 1.0)
+    r = mag / safe
+    total = (r**q).sum(axis=1, keepdims=True)
+    y = np.sign(m) * r ** (q - 1.0) / np.where(total > 0.0, total, 1.0) ** ((q - 1.0) / q)
+    return y, top[:, 0] * total[:, 0] ** (1.0 / q)
+
+
+def support_points(
+    normals: ArrayLike, semi_axes: ArrayLike, e: float | tuple[float, float]
+) -> tuple[NDArray, NDArray]:
     """Boundary points with the given outward normals, and the support values ``n . x``.
 
     Parameters
@@ -61,25 +94,33 @@ def support_points(normals: ArrayLike, semi_axes: ArrayLike, e: float) -> tuple[
     normals : array_like, shape (k, n)
         Unit outward normals (local frame).
     semi_axes : array_like, shape (n,)
-    e : float
-        Exponent, ``0 < e < 2``.
+    e : float or (float, float)
+        Exponent ``0 < e < 2``, or in 3D Barr's pair ``(e1, e2)`` (``e1`` between the
+        z axis and the xy plane, ``e2`` within the xy plane; HRM's column order).
 
     Returns
     -------
     points : ndarray, shape (k, n)
     values : ndarray, shape (k,)
+
+    Notes
+    -----
+    With two exponents the shape is ``{(r u, z) : u in the p2-ball of (a, b),
+    (r, z / c) in the p1-ball}``; for a fixed ``r`` the best ``u`` gives
+    ``r M`` with ``M = |(a n_x, b n_y)|_{q2}``, leaving the 2D problem
+    ``max r M + (z / c) c n_z`` over the p1-ball, whose value is
+    ``|(M, c n_z)|_{q1}`` (both steps Hoelder's equality case).
     """
-    p = _exponent(e)
-    q = p / (p - 1.0)
     a = np.asarray(semi_axes, dtype=float)
-    m = np.asarray(normals, dtype=float) * a
-    mag = np.abs(m)
-    # |m|_q with the largest entry factored out: |m_i|^q underflows for q near 1 and tiny m
-    top = mag.max(axis=1, keepdims=True)
-    r = mag / top
-    norm_q = top[:, 0] * (r**q).sum(axis=1) ** (1.0 / q)
-    y = np.sign(m) * r ** (q - 1.0) / ((r**q).sum(axis=1, keepdims=True) ** ((q - 1.0) / q))
-    return y * a, norm_q
+    N = np.asarray(normals, dtype=float)
+    p1, p2 = _exponents(e, len(a))
+    if len(a) == 2 or p1 == p2:
+        y, values = _holder(N * a, p1)
+        return y * a, values
+    y_xy, M = _holder(N[:, :2] * a[:2], p2)
+    rz, values = _holder(np.column_stack([M, a[2] * N[:, 2]]), p1)
+    points = np.column_stack([rz[:, :1] * y_xy * a[:2], rz[:, 1] * a[2]])
+    return points, values
 
 
 def unit_normals(n: int, count: int) -> NDArray[np.float64]:
@@ -120,18 +161,9 @@ class BoundingPolytopes:
         self.error = error
 
 
-def _oriented_faces(hull: ConvexHull) -> NDArray:
-    faces = hull.simplices.copy()
-    centre = hull.points[hull.vertices].mean(axis=0)
-    for f, (i, j, k) in enumerate(faces):
-        P = hull.points
-        normal = np.cross(P[j] - P[i], P[k] - P[i])
-        if normal @ (P[i] - centre) < 0:
-            faces[f] = (i, k, j)
-    return faces
-
-
-def bounding_polytopes(semi_axes: ArrayLike, e: float, count: int = 256) -> BoundingPolytopes:
+def bounding_polytopes(
+    semi_axes: ArrayLike, e: float | tuple[float, float], count: int = 256
+) -> BoundingPolytopes:
     """Circumscribed and inscribed polytopes of a superellipse/superquadric (local frame).
 
     ``count`` normals (2D: rounded up to a multiple of 4; 3D: plus the 6 axis normals).
@@ -152,11 +184,10 @@ def bounding_polytopes(semi_axes: ArrayLike, e: float, count: int = 256) -> Boun
         height = np.abs(chord[:, 0] * rel[:, 1] - chord[:, 1] * rel[:, 0])
         error = float((height / np.linalg.norm(chord, axis=1)).max())
         return BoundingPolytopes(corners, points, None, None, error)
-    outer = ConvexHull(HalfspaceIntersection(halfspaces, np.zeros(n)).intersections)
-    inner = ConvexHull(points)
-    inner_faces = _oriented_faces(inner)
-    error = float(point_triangle_distance(outer.points, points[inner_faces]).max())
-    return BoundingPolytopes(outer.points, points, _oriented_faces(outer), inner_faces, error)
+    outer, outer_faces = convex_hull(HalfspaceIntersection(halfspaces, np.zeros(n)).intersections)
+    inner, inner_faces = convex_hull(points)
+    error = float(hull_distance_bound(outer, inner, inner_faces).max())
+    return BoundingPolytopes(outer, inner, outer_faces, inner_faces, error)
 
 
 def point_triangle_distance(
@@ -165,24 +196,49 @@ def point_triangle_distance(
     """Distance from each point (k, 3) to the nearest of the triangles (f, 3, 3)."""
     P = np.asarray(points, dtype=float)
     T = np.asarray(triangles, dtype=float)
-    A, B, C = T[:, 0], T[:, 1], T[:, 2]
-    normal = np.cross(B - A, C - A)
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    edges = [(A, B), (B, C), (C, A)]
     out = np.empty(len(P))
     for start in range(0, len(P), chunk):
-        p = P[start : start + chunk, None, :]  # (c, 1, 3)
-        # inside the prism over the triangle: the plane distance
-        plane = np.einsum("cfi,fi->cf", p - A, normal)
-        foot = p - plane[..., None] * normal
-        inside = np.ones(plane.shape, dtype=bool)
-        for U, V in edges:
-            inside &= np.einsum("cfi,fi->cf", np.cross(V - U, foot - U), normal) >= 0
-        best = np.where(inside, np.abs(plane), np.inf)
-        for U, V in edges:  # otherwise the nearest edge point
-            d = V - U
-            t = np.clip(np.einsum("cfi,fi->cf", p - U, d) / np.einsum("fi,fi->f", d, d), 0, 1)
-            gap = np.linalg.norm(p - (U + t[..., None] * d), axis=2)
-            best = np.minimum(best, gap)
-        out[start : start + chunk] = best.min(axis=1)
+        p = P[start : start + chunk, None, :]  # (c, 1, 3) against (1, f, 3)
+        out[start : start + chunk] = _triangle_distances(p, T[None]).min(axis=1)
     return out
+
+
+def hull_distance_bound(
+    points: ArrayLike, vertices: ArrayLike, faces: ArrayLike, candidates: int = 16
+) -> NDArray[np.float64]:
+    """An upper bound of the distance from each point (k, 3) to a closed convex
+    triangulated surface: the distance to the nearest of the ``candidates`` triangles
+    whose planes the point lies farthest outside of (a subset of the triangles, so never
+    below the true distance; for a point outside the hull the nearest face is among the
+    faces it sees, and in practice among these, at a fraction of
+    :func:`point_triangle_distance`'s cost)."""
+    P = np.asarray(points, dtype=float)
+    V = np.asarray(vertices, dtype=float)
+    T = V[np.asarray(faces)]
+    normal = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    height = P @ normal.T - np.einsum("fi,fi->f", normal, T[:, 0])  # (k, f)
+    k = min(candidates, len(T))
+    best = np.argpartition(-height, k - 1, axis=1)[:, :k]
+    return _triangle_distances(P[:, None, :], T[best]).min(axis=1)
+
+
+def _triangle_distances(p: NDArray, T: NDArray) -> NDArray[np.float64]:
+    """Distances between points ``p`` (..., 3) and triangles ``T`` (..., 3, 3),
+    broadcast against each other."""
+    A, B, C = T[..., 0, :], T[..., 1, :], T[..., 2, :]
+    normal = np.cross(B - A, C - A)
+    normal = normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+    # inside the prism over the triangle: the plane distance
+    plane = np.einsum("...i,...i->...", p - A, normal)
+    foot = p - plane[..., None] * normal
+    inside = np.ones(plane.shape, dtype=bool)
+    for U, V in ((A, B), (B, C), (C, A)):
+        inside &= np.einsum("...i,...i->...", np.cross(V - U, foot - U), normal) >= 0
+    best = np.where(inside, np.abs(plane), np.inf)
+    for U, V in ((A, B), (B, C), (C, A)):  # otherwise the nearest edge point
+        d = V - U
+        t = np.einsum("...i,...i->...", p - U, d) / np.einsum("...i,...i->...", d, d)
+        gap = np.linalg.norm(p - (U + np.clip(t, 0, 1)[..., None] * d), axis=-1)
+        best = np.minimum(best, gap)
+    return best

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan.geometry.pose import Edge
+from kcplan.geometry.robot import Robot
 from kcplan.planning.certificates import (
     CERTIFICATE_NAMES,
     ClearanceBall,
@@ -93,11 +94,12 @@ class EdgeCertifier:
     Parameters
     ----------
     world : object
-        ``in_collision(pose)``, ``safe_clearance(pose)``; for ``region`` also
-        ``free_region(pose, horizon)`` and ``clearance_atol``; for ``sweep_test``
+        ``in_collision(pose)`` and ``safe_body_clearances(pose)`` (one number per body;
+        ``safe_clearance(pose)`` suffices for one body), ``robot`` unless given; for ``region``
+        also ``free_regions(pose, horizon)`` and ``clearance_atol``; for ``sweep_test``
         ``sweep_core_collides(t1, t2, radius)``: :class:`kcplan.world.CollisionWorld`.
-    semi_axes : array_like, shape (n,), optional
-        Default ``world.semi_axes``.
+    robot : Robot or array_like, optional
+        Default ``world.robot``; semi-axes ``(n,)`` mean one body at the origin.
     certificates : sequence of str, optional
         Names from :data:`kcplan.planning.certificates.CERTIFICATE_NAMES`; default
         ``CERTIFICATE_SETS["kc"]``, or ``("rotation",)`` for a world without region
@@ -105,17 +107,21 @@ class EdgeCertifier:
     ladder : GuardLadder, optional
         For ``polytope``; built on demand.
     horizon : float, optional
-        Region horizon ``H`` in length units; default ``max(a)``.
+        Region horizon ``H`` in length units; default the largest semi-axis of any body.
     fallback : {"bisection", "discrete"}
     max_guards : int
         Guards per edge after the endpoints before "not proven".
     sweep_test : bool, optional
         Step 3 (default: when the world has ``sweep_core_collides``).
     occupancy : bool, optional
-        Reject states whose centre lies in a cell of :class:`CoreOccupancy` proven
+        Reject states whose origin lies in a cell of :class:`CoreOccupancy` proven
         blocked for every orientation, with no query; a cell is tested (one query) the
         first time a state in it collides (default: when the world has
         ``ball_collides`` and ``scenario``).
+
+    Steps 1 and 3 use the robot's core, the ball of radius
+    :attr:`kcplan.geometry.robot.Robot.core_radius` about its origin; a robot whose
+    bodies do not cover its origin has none, and those tests are off.
     cache : GuardCache, optional
         Shared with the state validity checker (see :meth:`state_valid`).
 
@@ -125,7 +131,7 @@ class EdgeCertifier:
     def __init__(
         self,
         world,
-        semi_axes: ArrayLike | None = None,
+        robot: Robot | ArrayLike | None = None,
         certificates: Sequence[str] | None = None,
         ladder: GuardLadder | None = None,
         horizon: float | None = None,
@@ -135,13 +141,22 @@ class EdgeCertifier:
         cache: GuardCache | None = None,
         occupancy: bool | None = None,
     ):
-        regions = hasattr(world, "free_region")
+        regions = hasattr(world, "free_regions")
         if certificates is None:
             certificates = CERTIFICATE_SETS["kc"] if regions else ("rotation",)
-        sweep_test = _supported(world, "sweep_test", sweep_test, "sweep_core_collides")
-        occupancy = _supported(world, "occupancy", occupancy, "ball_collides", "scenario")
+        robot = Robot.of(world.robot if robot is None else robot)
+        core = robot.core_radius > 0.0
+        sweep_test = core and _supported(world, "sweep_test", sweep_test, "sweep_core_collides")
+        occupancy = core and _supported(world, "occupancy", occupancy, "ball_collides", "scenario")
         if "region" in certificates and not regions:
-            raise ValueError("certificates: 'region' needs a world with free_region(pose, horizon)")
+            raise ValueError(
+                "certificates: 'region' needs a world with free_regions(pose, horizon)"
+            )
+        if "polytope" in certificates and not robot.is_single:
+            raise ValueError(
+                "certificates: 'polytope' (the paper's bound) needs one body centred at the "
+                f"robot's origin, got {robot.describe()}"
+            )
         if fallback not in ("bisection", "discrete"):
             raise ValueError(f"fallback: expected 'bisection' or 'discrete', got {fallback!r}")
         unknown = [c for c in certificates if c not in CERTIFICATE_NAMES]
@@ -150,21 +165,25 @@ class EdgeCertifier:
                 f"certificates: expected names from {', '.join(CERTIFICATE_NAMES)}, "
                 f"got {list(certificates)}"
             )
+        if not hasattr(world, "safe_body_clearances") and len(robot) > 1:
+            raise ValueError(
+                f"world: a robot of {len(robot)} bodies needs safe_body_clearances(pose)"
+            )
         self.world = world
-        a = np.asarray(world.semi_axes if semi_axes is None else semi_axes, dtype=float)
-        self.semi_axes, self.n = a, len(a)
-        self.core_radius = float(a.min())
+        self.robot, self.n = robot, robot.dimension
+        self.core_radius = robot.core_radius
         self.certificates = []
         for name in certificates:
             if name in ("ball", "rotation"):
-                self.certificates.append(ClearanceBall(a, rotation_aware=name == "rotation"))
+                self.certificates.append(ClearanceBall(robot, rotation_aware=name == "rotation"))
             elif name == "polytope":
-                self.certificates.append(KCPolytope(ladder or GuardLadder(a)))
+                self.certificates.append(KCPolytope(ladder or GuardLadder(robot.semi_axes)))
             else:
-                self.certificates.append(FreeRegionPlanes(a))
+                self.certificates.append(FreeRegionPlanes(robot))
         self.use_region = "region" in certificates
-        self.horizon = float(a.max() if horizon is None else horizon)
-        self.margin = float(getattr(world, "clearance_atol", 0.0)) + 1e-12 * float(a.max())
+        largest = robot.largest_semi_axis
+        self.horizon = float(largest if horizon is None else horizon)
+        self.margin = float(getattr(world, "clearance_atol", 0.0)) + 1e-12 * robot.reach
         self.fallback = fallback
         self.max_guards = int(max_guards)
         self.sweep_test = bool(sweep_test)
@@ -187,13 +206,21 @@ class EdgeCertifier:
         """One guard query at ``pose`` (not cached)."""
         self.counters["guards"] += 1
         if self.use_region:
-            region = self.world.free_region(pose, self.horizon)
-            guard = Guard.from_region(pose, region, self.semi_axes, self.margin)
+            regions = self.world.free_regions(pose, self.horizon)
+            guard = Guard.from_regions(pose, regions, self.robot, self.margin)
         else:
-            guard = Guard(pose, self.world.safe_clearance(pose))
+            guard = Guard.of_clearances(pose, self._body_clearances(pose))
         if self.guard_log is not None and guard.clearance > 0.0:
-            self.guard_log.append((pose, guard.clearance / float(self.semi_axes.max())))
+            # every body inflated by this factor about its centre is free
+            self.guard_log.append((pose, guard.clearance / self.robot.largest_semi_axis))
         return guard
+
+    def _body_clearances(self, pose: np.ndarray):
+        """Per-body clearances; a one-body world may offer ``safe_clearance`` alone."""
+        world = self.world
+        if hasattr(world, "safe_body_clearances"):
+            return world.safe_body_clearances(pose)
+        return (world.safe_clearance(pose),)
 
     def state_valid(self, pose: ArrayLike, key: bytes | None = None) -> bool:
         """State validity with the cache: one collision query for a pose not seen before,

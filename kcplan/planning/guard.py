@@ -8,96 +8,122 @@ later edge from that state with no new query (:class:`GuardCache`).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.geometry.pose import rotate_vector
+from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
 
-__all__ = ["Guard", "GuardCache"]
+__all__ = ["BodyGuard", "Guard", "GuardCache"]
+
+
+class BodyGuard(NamedTuple):
+    """What a guard knows about one body of the robot.
+
+    Attributes
+    ----------
+    clearance : float
+        Distance from the body to every obstacle, never an overestimate (0: touching or
+        too close to tell).
+    planes : tuple of (nx, ny, nz, slack, clearance)
+        One row per obstacle piece within ``horizon`` of the body (region guards only;
+        empty otherwise), as plain floats (certificates loop over a handful of pieces
+        faster than numpy can): the unit direction from the piece towards the body
+        (``nz = 0`` in 2D); the body's *slack* ``sigma_i = n_i . c - |A R^T n_i| - c_i -
+        margin`` (body centre ``c``, world orientation ``R``), by how much the body clears
+        the piece's separating plane ``n_i . x <= c_i`` (``-inf`` without a plane); and
+        the body's clearance to the piece.
+    horizon : float
+        Every piece not listed is at least this far from the body.
+    """
+
+    clearance: float
+    planes: tuple = ()
+    horizon: float = 0.0
 
 
 class Guard:
-    """Measurements at one robot pose.
+    """Measurements at one robot pose, per body.
 
     Attributes
     ----------
     pose : ndarray, shape (3,) or (7,)
+    bodies : tuple of BodyGuard
+        One per body of the robot, in the robot's order.
     clearance : float
-        Distance from the robot to every obstacle, never an overestimate (0: touching or
-        too close to tell).
-    planes : tuple of (nx, ny, nz, slack, clearance)
-        One row per obstacle piece within ``horizon`` (region guards only; empty
-        otherwise), as plain floats (certificates loop over a handful of pieces faster
-        than numpy can): the unit direction from the piece towards the robot (``nz = 0``
-        in 2D); the robot's *slack* ``sigma_i = n_i . t - |A R^T n_i| - c_i - margin``,
-        by how much the robot clears the piece's separating plane ``n_i . x <= c_i``
-        (``-inf`` without a plane); and the robot's clearance to the piece.
-    horizon : float
-        Every piece not listed is at least this far from the robot (``clearance``
-        for a guard without a region).
+        The smallest body clearance: distance from the robot to every obstacle, never an
+        overestimate (0: touching or too close to tell).
     """
 
-    __slots__ = ("pose", "clearance", "planes", "horizon")
+    __slots__ = ("pose", "bodies", "clearance")
 
-    def __init__(
-        self, pose: NDArray, clearance: float, planes: tuple = (), horizon: float | None = None
-    ):
+    def __init__(self, pose: NDArray, bodies: tuple[BodyGuard, ...]):
         self.pose = pose
-        self.clearance = float(clearance)
-        self.planes = planes
-        self.horizon = self.clearance if horizon is None else float(horizon)
+        self.bodies = bodies
+        self.clearance = min(b.clearance for b in bodies)
+
+    @classmethod
+    def of_clearances(cls, pose: NDArray, clearances) -> Guard:
+        """A clearance-only guard: body ``k`` has clearance (and horizon) ``clearances[k]``."""
+        return cls(pose, tuple(BodyGuard(float(d), (), float(d)) for d in clearances))
 
     @property
     def slacks(self) -> NDArray[np.float64]:
-        """The planes' slacks, shape (k,)."""
-        return np.array([row[3] for row in self.planes])
+        """The planes' slacks of every body, shape (total pieces,)."""
+        return np.array([row[3] for b in self.bodies for row in b.planes])
 
     @property
-    def clearances(self) -> NDArray[np.float64]:
-        """The pieces' clearances, shape (k,)."""
-        return np.array([row[4] for row in self.planes])
+    def piece_clearances(self) -> NDArray[np.float64]:
+        """The pieces' clearances of every body, shape (total pieces,)."""
+        return np.array([row[4] for b in self.bodies for row in b.planes])
 
     @classmethod
-    def from_region(
-        cls, pose: NDArray, region: FreeRegion, semi_axes: NDArray, margin: float
+    def from_regions(
+        cls, pose: NDArray, regions: tuple[FreeRegion, ...], robot: Robot, margin: float
     ) -> Guard:
-        """A guard from a region query at ``pose``.
+        """A guard from a region query at ``pose`` (one region per body).
 
-        The robot ``{t + R A u : |u| <= 1}`` has its lowest point along ``n`` at
-        ``n . t - |A R^T n|``, so it lies strictly on the free side of the plane
-        ``n . x <= c`` exactly when ``n . t - |A R^T n| - c > 0``; ``margin`` (a length)
-        absorbs floating-point rounding of that evaluation.
+        Body ``k`` at world pose ``(R, c)`` is ``{c + R A u : |u| <= 1}``; its lowest
+        point along ``n`` is ``n . c - |A R^T n|``, so it lies strictly on the free side
+        of the plane ``n . x <= c_i`` exactly when ``n . c - |A R^T n| - c_i > 0``;
+        ``margin`` (a length) absorbs floating-point rounding of that evaluation.
         """
-        if region.clearance <= 0.0:
-            return cls(pose, 0.0)
-        p = pose.tolist()
-        a = [float(v) for v in semi_axes] + [0.0] * (3 - len(semi_axes))
-        if len(semi_axes) == 2:  # a yaw is a rotation about z: the 3D formula serves
-            t = (p[0], p[1], 0.0)
-            conjugate = (0.0, 0.0, -math.sin(0.5 * p[2]), math.cos(0.5 * p[2]))
-        else:
-            t = tuple(p[:3])
-            qx, qy, qz, qw = p[3:]
-            norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-            conjugate = (-qx / norm, -qy / norm, -qz / norm, qw / norm)
-        pad = [0.0] * (3 - len(semi_axes))
-        rows = []
-        for normal, offset, d in zip(
-            region.normals.tolist(),
-            region.offsets.tolist(),
-            region.clearances.tolist(),
-            strict=True,
-        ):
-            nx, ny, nz = normal + pad
-            slack = -math.inf
-            if offset < math.inf:
-                ux, uy, uz = rotate_vector(conjugate, (nx, ny, nz))  # R^T n
-                h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)  # |A R^T n|
-                slack = nx * t[0] + ny * t[1] + nz * t[2] - h - offset - margin
-            rows.append((nx, ny, nz, slack, d))
-        return cls(pose, region.clearance, tuple(rows), region.horizon)
+        if any(region.clearance <= 0.0 for region in regions):
+            return cls.of_clearances(pose, [0.0] * len(regions))
+        n = robot.dimension
+        pad = [0.0] * (3 - n)
+        bodies = []
+        # one body at the origin (the common case) is at the robot's pose: no numpy
+        body_poses = [pose.tolist()] if robot.is_single else robot.body_poses(pose).tolist()
+        for body_pose, body, region in zip(body_poses, robot.bodies, regions, strict=True):
+            a = [float(v) for v in body.semi_axes] + pad
+            if n == 2:  # a yaw is a rotation about z: the 3D formula serves
+                c = (body_pose[0], body_pose[1], 0.0)
+                conjugate = (0.0, 0.0, -math.sin(0.5 * body_pose[2]), math.cos(0.5 * body_pose[2]))
+            else:
+                c = tuple(body_pose[:3])
+                qx, qy, qz, qw = body_pose[3:]
+                norm = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
+                conjugate = (-qx / norm, -qy / norm, -qz / norm, qw / norm)
+            rows = []
+            for normal, offset, d in zip(
+                region.normals.tolist(),
+                region.offsets.tolist(),
+                region.clearances.tolist(),
+                strict=True,
+            ):
+                nx, ny, nz = normal + pad
+                slack = -math.inf
+                if offset < math.inf:
+                    ux, uy, uz = rotate_vector(conjugate, (nx, ny, nz))  # R^T n
+                    h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)
+                    slack = nx * c[0] + ny * c[1] + nz * c[2] - h - offset - margin
+                rows.append((nx, ny, nz, slack, d))
+            bodies.append(BodyGuard(region.clearance, tuple(rows), region.horizon))
+        return cls(pose, tuple(bodies))
 
 
 class GuardCache:

@@ -197,9 +197,7 @@ def plan(
     checker_calls = [0]
     validator = None
     if spec.kc:
-        validator = KCMotionValidator(
-            si, scenario.semi_axes, world, spec.certificates, spec.fallback
-        )
+        validator = KCMotionValidator(si, scenario.robot, world, spec.certificates, spec.fallback)
         si.setMotionValidator(validator)
         state_valid = validator.state_valid  # shares the validator's guard cache
     else:

@@ -3,7 +3,7 @@
 Usable in any OMPL setup on SE(2) or SE(3)::
 
     from kcplan import KCMotionValidator
-    mv = KCMotionValidator(si, semi_axes, world)
+    mv = KCMotionValidator(si, robot, world)    # robot: Robot or semi-axes
     si.setMotionValidator(mv)
     ...
     mv.close()          # when done: breaks the si <-> validator reference cycle
@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
+from kcplan.geometry.robot import Robot
 from kcplan.planning.certifier import EdgeCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import state_pose
@@ -43,16 +44,17 @@ class KCMotionValidator(ob.MotionValidator):
     ----------
     si : ompl.base.SpaceInformation
         On an ``SE2StateSpace`` or ``SE3StateSpace``.
-    semi_axes : array_like, shape (2,) or (3,)
-        The robot's semi-axes, in the state space's length unit.
+    robot : Robot or array_like
+        The robot (:class:`kcplan.geometry.robot.Robot`), or the semi-axes ``(2,)`` or
+        ``(3,)`` of one ellipse/ellipsoid at the origin, in the state space's length unit.
     world : object
-        ``in_collision(pose) -> bool`` and ``safe_clearance(pose) -> float`` for flat
-        poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``; ``free_region`` for the
+        ``in_collision(pose) -> bool`` and ``safe_body_clearances(pose)`` for flat
+        poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``; ``free_regions`` for the
         ``region`` certificate and ``sweep_core_collides`` for ``sweep_test``, e.g.
         :class:`kcplan.world.CollisionWorld`.
     certificates : sequence of str, optional
         Default ``("region",)``, or ``("rotation",)`` when the world has no
-        ``free_region``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
+        ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
@@ -61,11 +63,11 @@ class KCMotionValidator(ob.MotionValidator):
         Guard inflation ladder of the ``polytope`` certificate (default
         :data:`kcplan.planning.ladder.DEFAULT_LADDER`).
     horizon : float, optional
-        Region horizon in length units (default ``max(a)``).
+        Region horizon in length units (default the largest semi-axis).
     max_guards : int
         Guards per edge before giving up ("not proven" rejects the edge).
     sweep_test : bool, optional
-        Reject an edge whose robot core (ball of radius ``min(a)``) sweeps into an
+        Reject an edge whose robot core (ball of radius ``min(a)`` for one body) sweeps into an
         obstacle with one collision query before measuring guards (default: when the
         world has ``sweep_core_collides``).
     """
@@ -73,7 +75,7 @@ class KCMotionValidator(ob.MotionValidator):
     def __init__(
         self,
         si: ob.SpaceInformation,
-        semi_axes: ArrayLike,
+        robot: Robot | ArrayLike,
         world,
         certificates: Sequence[str] | None = None,
         fallback: str = "bisection",
@@ -87,10 +89,10 @@ class KCMotionValidator(ob.MotionValidator):
         self.space = si.getStateSpace()
         ladder = None
         if certificates is not None and "polytope" in certificates:
-            ladder = GuardLadder(semi_axes, inflations)
+            ladder = GuardLadder(Robot.of(robot).semi_axes, inflations)
         self.certifier = EdgeCertifier(
             world,
-            semi_axes,
+            robot,
             certificates,
             ladder,
             horizon,

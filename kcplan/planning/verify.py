@@ -2,9 +2,11 @@
 
 A pose with clearance ``d`` proves free every pose of the edge whose robot points moved
 less than ``d`` from it; robot points move at most ``sweep_speed * |ds|``
-(:meth:`kcplan.geometry.pose.Edge.sweep_speed`: translation change plus ``max(a)`` times
-rotation angle change). Stepping by ``d / sweep_speed`` therefore covers each edge
-without gaps, however thin the obstacles, using only FCL clearances.
+(:meth:`kcplan.geometry.pose.Edge.sweep_speed`: translation change plus the robot's
+reach times rotation angle change; the reach is the largest distance of a point of any
+body from the robot's origin, :attr:`kcplan.geometry.robot.Robot.reach`). Stepping by
+``d / sweep_speed`` therefore covers each edge without gaps, however thin the obstacles,
+using only FCL clearances (the minimum over bodies).
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ def verify_path(
         Safety limit; exceeding it is reported as a collision (not proven free).
     """
     P = np.asarray(states, dtype=float)
-    n, radius = world.dimension, float(np.max(world.semi_axes))
+    n, radius = world.dimension, world.robot.reach
     queries, lowest = 0, np.inf
     if len(P) == 1:
         P = np.vstack([P, P])

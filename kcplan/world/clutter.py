@@ -11,9 +11,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kcplan.geometry.robot import Body, Robot
 from kcplan.world.scenario import Scenario, parse_scenario
 
-__all__ = ["random_pose", "random_obstacles", "random_scenario"]
+__all__ = ["random_pose", "random_obstacles", "random_robot", "random_scenario"]
 
 
 def random_pose(rng: np.random.Generator, n: int, low: float, high: float) -> NDArray:
@@ -58,21 +59,33 @@ def random_obstacles(rng: np.random.Generator, n: int, count: int, spread: float
     return obstacles
 
 
+def random_robot(rng: np.random.Generator, n: int, bodies: int, offset: float = 3.0) -> Robot:
+    """A robot of ``bodies`` ellipses/ellipsoids with semi-axes 0.2 to 2, each centred
+    uniformly within ``offset`` of the origin per coordinate (the first body too, so the
+    origin may lie outside every body) in a random orientation."""
+    out = []
+    for _ in range(bodies):
+        pose = random_pose(rng, n, -offset, offset)
+        out.append(Body(rng.uniform(0.2, 2.0, n), pose))
+    return Robot(out)
+
+
 def random_scenario(
     rng: np.random.Generator,
     n: int,
-    semi_axes: ArrayLike,
+    robot: Robot | ArrayLike,
     count: int,
     half_width: float = 25.0,
 ) -> Scenario:
     """A scenario with ``count`` :func:`random_obstacles` centred within
     ``half_width - 5`` of the origin, bounds ``[-half_width, half_width]^n``, and the
-    robot ``semi_axes``; start and goal are placeholders (not checked)."""
+    robot (or the semi-axes of one body at the origin); start and goal are placeholders
+    (not checked)."""
     data = {
         "name": "clutter",
         "dimension": n,
         "bounds": {"low": [-half_width] * n, "high": [half_width] * n},
-        "robot": {"semi_axes": [float(v) for v in semi_axes]},
+        "robot": Robot.of(robot).to_spec(),
         "start": {"position": [0] * n},
         "goal": {"position": [1] + [0] * (n - 1)},
         "obstacles": random_obstacles(rng, n, count, half_width - 5.0),

@@ -33,7 +33,8 @@ import fcl
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kcplan.geometry.pose import pose_size
+from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
+from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario
 from kcplan.world.support import box_vertices, piece_supports
@@ -89,34 +90,57 @@ class CollisionWorld:
     Parameters
     ----------
     scenario : Scenario
-        The obstacles and the robot semi-axes.
-    semi_axes : array_like, optional
-        Query a different robot shape (e.g. a guard ``(1 + eps) a``); default the
-        scenario's robot.
+        The obstacles and the robot.
+    robot : Robot or array_like, optional
+        Query a different robot (semi-axes ``(n,)`` for one body at the origin, e.g. a
+        guard ``(1 + eps) a``); default the scenario's robot.
 
     Notes
     -----
     Poses are flat vectors, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``
-    (:mod:`kcplan.geometry.pose`). The bounds of the scenario are not obstacles: they
-    limit where the planner samples the robot's centre.
+    (:mod:`kcplan.geometry.pose`), of the robot's frame; body ``k`` is placed at
+    ``(R R_k, t + R p_k)`` (:mod:`kcplan.geometry.robot`). The bounds of the scenario
+    are not obstacles: they limit where the planner samples the robot's origin.
 
-    ``counters`` counts FCL queries issued through this object: ``collision_queries``
-    and ``distance_queries`` go up by exactly one per pose queried. Not thread-safe:
-    the robot's FCL object is reused between queries.
+    ``counters`` counts FCL queries issued through this object: ``collision_queries``,
+    ``distance_queries`` and ``region_queries`` go up by exactly one per robot pose
+    queried, ``body_queries`` by the number of bodies actually queried (a collision
+    query stops at the first colliding body); ``body_query_counts`` splits the latter
+    per body. Not thread-safe: the robot's FCL objects are reused between queries.
     """
 
-    def __init__(self, scenario: Scenario, semi_axes: ArrayLike | None = None):
+    def __init__(self, scenario: Scenario, robot: Robot | ArrayLike | None = None):
         n = scenario.dimension
-        a = np.asarray(scenario.semi_axes if semi_axes is None else semi_axes, dtype=float)
-        if a.shape != (n,) or not (a > 0).all():
-            raise ValueError(f"semi_axes: expected {n} positive numbers, got {a.tolist()}")
+        if robot is None:
+            robot = scenario.robot
+        elif not isinstance(robot, Robot):
+            a = np.asarray(robot, dtype=float)
+            if a.shape != (n,) or not (a > 0).all():
+                raise ValueError(f"semi_axes: expected {n} positive numbers, got {a.tolist()}")
+            robot = Robot.single(a)
+        if robot.dimension != n:
+            raise ValueError(f"robot: expected a {n}D robot, got {robot.dimension}D")
         self.dimension = n
-        self.semi_axes = a
+        self.robot = robot
         self.scenario = scenario
-        geometry = fcl.Ellipsoid(*a) if n == 3 else fcl.Ellipsoid(a[0], a[1], float(a.min()))
-        self._robot_geometry = geometry
-        self._robot = fcl.CollisionObject(geometry, fcl.Transform())
-        self._half_height = float(max(a.max(), 1.0))
+        self._geometries = [
+            fcl.Ellipsoid(*a) if n == 3 else fcl.Ellipsoid(a[0], a[1], float(a.min()))
+            for a in (b.semi_axes for b in robot.bodies)
+        ]
+        self._bodies = [fcl.CollisionObject(g, fcl.Transform()) for g in self._geometries]
+        # body poses in the robot frame as plain floats: (x, y, z), quaternion [x, y, z, w]
+        self._offsets = [
+            (*(float(v) for v in b.position), 0.0)[:3] if n == 2 else tuple(b.position.tolist())
+            for b in robot.bodies
+        ]
+        self._turns = [
+            (0.0, 0.0, math.sin(0.5 * b.pose[2]), math.cos(0.5 * b.pose[2]))
+            if n == 2
+            else tuple(b.pose[3:].tolist())
+            for b in robot.bodies
+        ]
+        self._single = robot.is_single
+        self._half_height = float(max(robot.largest_semi_axis, 1.0))
         self._objects: list[fcl.CollisionObject] = []
         self.owner: list[int] = []  # obstacle index of each FCL object
         # id of an FCL geometry -> the exact support function of its piece, or None
@@ -133,17 +157,18 @@ class CollisionWorld:
             self._manager.setup()
         self._pose_size = pose_size(n)
         self.clearance_atol = CLEARANCE_ATOL * float(
-            max(np.ptp(scenario.bounds, axis=0).max(), a.max())
+            max(np.ptp(scenario.bounds, axis=0).max(), robot.reach)
         )
-        self._reach = float(a.max())  # the robot lies within this distance of its centre
-        self._horizon_boxes: dict[float, fcl.CollisionObject] = {}
+        self._horizon_boxes: dict[tuple[int, float], fcl.CollisionObject] = {}
         self._pair_request = fcl.DistanceRequest(enable_nearest_points=True)
         self.counters = {
             "collision_queries": 0,
             "distance_queries": 0,
             "region_queries": 0,
             "region_pairs": 0,
+            "body_queries": 0,
         }
+        self.body_query_counts = [0] * len(robot.bodies)
 
     def _fcl_parts(self, ob: Obstacle) -> list[tuple]:
         n, identity = self.dimension, fcl.Transform()
@@ -159,6 +184,9 @@ class CollisionWorld:
         if ob.kind in ("ellipse", "ellipsoid"):
             axes = ob.extents if n == 3 else [*ob.extents, float(ob.extents.min())]
             return [(fcl.Ellipsoid(*axes), fcl.Transform(_embed(ob.rotation, n), center3))]
+        if ob.kind == "convex":
+            faces = np.column_stack([np.full(len(ob.triangles), 3), ob.triangles]).ravel()
+            return [(fcl.Convex(ob.vertices, len(ob.triangles), faces.astype(np.int32)), identity)]
         if ob.kind == "mesh":
             model = fcl.BVHModel()
             model.beginModel(len(ob.vertices), len(ob.triangles))
@@ -176,8 +204,10 @@ class CollisionWorld:
         """Set the query counters to zero."""
         for key in self.counters:
             self.counters[key] = 0
+        self.body_query_counts = [0] * len(self._bodies)
 
     def _place(self, pose: ArrayLike) -> None:
+        """Move every body's FCL object to the robot pose ``pose``."""
         p = pose if isinstance(pose, np.ndarray) else np.asarray(pose, dtype=float)
         if p.shape != (self._pose_size,):
             raise ValueError(
@@ -187,22 +217,39 @@ class CollisionWorld:
         # plain floats: numpy costs microseconds per call on 4-vectors
         if self.dimension == 2:
             x, y, yaw = p.tolist()
-            half = 0.5 * yaw
-            q = np.array([math.cos(half), 0.0, 0.0, math.sin(half)])
-            self._robot.setTransform(fcl.Transform(q, np.array([x, y, 0.0])))
+            t, half = (x, y, 0.0), 0.5 * yaw
+            q = (0.0, 0.0, math.sin(half), math.cos(half))
         else:
             x, y, z, qx, qy, qz, qw = p.tolist()
             norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-            q = np.array([qw / norm, qx / norm, qy / norm, qz / norm])  # FCL: [w, x, y, z]
-            self._robot.setTransform(fcl.Transform(q, np.array([x, y, z])))
+            t, q = (x, y, z), (qx / norm, qy / norm, qz / norm, qw / norm)
+        if self._single:
+            self._bodies[0].setTransform(
+                fcl.Transform(np.array([q[3], q[0], q[1], q[2]]), np.array(t))
+            )
+            return
+        for body, offset, turn in zip(self._bodies, self._offsets, self._turns, strict=True):
+            ox, oy, oz = rotate_vector(q, offset)
+            bx, by, bz, bw = quaternion_multiply(q, turn)
+            centre = np.array([t[0] + ox, t[1] + oy, t[2] + oz])
+            body.setTransform(fcl.Transform(np.array([bw, bx, by, bz]), centre))  # [w, x, y, z]
+
+    def _count_body(self, k: int) -> None:
+        self.counters["body_queries"] += 1
+        self.body_query_counts[k] += 1
 
     def in_collision(self, pose: ArrayLike) -> bool:
-        """Whether the robot at ``pose`` touches or overlaps an obstacle (one FCL query)."""
+        """Whether some body of the robot at ``pose`` touches or overlaps an obstacle
+        (one collision query; one FCL query per body until a body collides)."""
         self._place(pose)
         self.counters["collision_queries"] += 1
         if not self._objects:
             return False
-        return self._collides(self._robot)
+        for k, body in enumerate(self._bodies):
+            self._count_body(k)
+            if self._collides(body):
+                return True
+        return False
 
     def _collides(self, obj: fcl.CollisionObject) -> bool:
         """One broad- and narrow-phase collision query of ``obj`` against the obstacles."""
@@ -210,82 +257,121 @@ class CollisionWorld:
         self._manager.collide(obj, data, fcl.defaultCollisionCallback)
         return bool(data.result.is_collision)
 
-    def clearance(self, pose: ArrayLike) -> float:
-        """Distance from the robot at ``pose`` to the nearest obstacle, 0 when they touch
-        or overlap, ``inf`` without obstacles (one FCL query). In length units. FCL's GJK
-        is iterative and may overestimate by up to :data:`CLEARANCE_RTOL` relative plus
-        :data:`CLEARANCE_ATOL`: see :meth:`safe_clearance`."""
+    def body_clearances(self, pose: ArrayLike) -> NDArray[np.float64]:
+        """Distance from each body of the robot at ``pose`` to the nearest obstacle, shape
+        ``(k,)``: 0 when the body touches or overlaps one, ``inf`` without obstacles (one
+        distance query; one FCL query per body). In length units. FCL's GJK is iterative
+        and may overestimate by up to :data:`CLEARANCE_RTOL` relative plus
+        :data:`CLEARANCE_ATOL`: see :meth:`safe_body_clearances`."""
         self._place(pose)
         self.counters["distance_queries"] += 1
         if not self._objects:
-            return float("inf")
-        data = fcl.DistanceData()
-        self._manager.distance(self._robot, data, fcl.defaultDistanceCallback)
-        return max(float(data.result.min_distance), 0.0)
+            return np.full(len(self._bodies), math.inf)
+        out = np.empty(len(self._bodies))
+        for k, body in enumerate(self._bodies):
+            self._count_body(k)
+            data = fcl.DistanceData()
+            self._manager.distance(body, data, fcl.defaultDistanceCallback)
+            out[k] = max(float(data.result.min_distance), 0.0)
+        return out
+
+    def clearance(self, pose: ArrayLike) -> float:
+        """Distance from the robot at ``pose`` to the nearest obstacle, the minimum of
+        :meth:`body_clearances` (one distance query)."""
+        return float(self.body_clearances(pose).min())
+
+    def safe_body_clearances(self, pose: ArrayLike) -> NDArray[np.float64]:
+        """:meth:`body_clearances` reduced by FCL's error allowance, distances that are
+        certain: ``max(d (1 - CLEARANCE_RTOL) - clearance_atol, 0)`` with
+        ``clearance_atol = CLEARANCE_ATOL * scene size`` (one distance query)."""
+        d = self.body_clearances(pose)
+        return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
 
     def safe_clearance(self, pose: ArrayLike) -> float:
-        """:meth:`clearance` reduced by FCL's error allowance, a distance that is certain:
-        ``max(d (1 - CLEARANCE_RTOL) - clearance_atol, 0)`` with ``clearance_atol =
-        CLEARANCE_ATOL * scene size`` (one FCL query)."""
-        d = self.clearance(pose)
-        return max(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+        """The minimum of :meth:`safe_body_clearances` (one distance query)."""
+        return float(self.safe_body_clearances(pose).min())
 
-    def free_region(self, pose: ArrayLike, horizon: float) -> FreeRegion:
-        """Separating planes and clearances of every obstacle piece within ``horizon`` of
-        the robot at ``pose`` (one region query: a broad-phase query, then one
-        narrow-phase distance per piece found; see :mod:`kcplan.world.region`).
+    def free_regions(self, pose: ArrayLike, horizon: float) -> tuple[FreeRegion, ...]:
+        """For each body of the robot at ``pose``: the separating planes and clearances of
+        every obstacle piece within ``horizon`` of the body (one region query: per body a
+        broad-phase query, then one narrow-phase distance per piece found; see
+        :mod:`kcplan.world.region`).
 
         Pieces are found by their FCL bounding boxes overlapping the cube of half side
-        ``max(a) + horizon`` around the robot's centre, which contains every point within
-        ``horizon`` of the robot; a piece outside it is therefore at least ``horizon``
-        away. With no piece that close, one distance query (counted as such) widens the
-        horizon to the robot's clearance. Returns :meth:`FreeRegion.colliding` as soon as
-        a piece touches the robot.
+        ``max(a_k) + horizon`` around body ``k``'s centre, which contains every point
+        within ``horizon`` of the body; a piece outside it is therefore at least
+        ``horizon`` away. A body with no piece that close gets one distance query
+        (counted as such) that widens its horizon to its clearance. As soon
+        as a piece touches a body, every region is :meth:`FreeRegion.colliding`.
         """
         n = self.dimension
         self._place(pose)
         self.counters["region_queries"] += 1
         horizon = float(horizon)
         if not self._objects:
-            return FreeRegion.empty(n, math.inf)
-        box = self._horizon_boxes.get(horizon)
-        if box is None:
-            side = 2.0 * (self._reach + horizon)
-            height = side if n == 3 else 4.0 * self._half_height  # 2D: cover every prism
-            box = fcl.CollisionObject(fcl.Box(side, side, height), fcl.Transform())
-            self._horizon_boxes[horizon] = box
-        p = np.asarray(pose, dtype=float)
-        box.setTranslation(p[:3] if n == 3 else np.array([p[0], p[1], 0.0]))
+            return (FreeRegion.empty(n, math.inf),) * len(self._bodies)
+        regions = []
+        request, rtol = self._pair_request, 1.0 - CLEARANCE_RTOL
         near: list[fcl.CollisionObject] = []
-        self._manager.collide(box, None, lambda o1, _o2, _data: near.append(o1) or False)
-        self.counters["region_pairs"] += len(near)
-        if not near:  # open space: the clearance to everything is the better horizon
-            return FreeRegion.empty(n, max(horizon, self.safe_clearance(p)))
-        normals, offsets, clearances = [], [], []
-        robot, request, rtol = self._robot, self._pair_request, 1.0 - CLEARANCE_RTOL
-        for obstacle in near:
-            result = fcl.DistanceResult()
-            d = fcl.distance(robot, obstacle, request, result)
-            if d <= 0.0:
-                return FreeRegion.colliding(n)
-            clearances.append(max(d * rtol - self.clearance_atol, 0.0))
-            # FCL swaps the pair (and its nearest points) for some geometry types (meshes)
-            if result.o1 is self._robot_geometry:
-                piece, (p_robot, p_obstacle) = result.o2, result.nearest_points
-            else:
-                piece, (p_obstacle, p_robot) = result.o1, result.nearest_points
-            support = self._support_of[id(piece)]
-            direction = (p_robot - p_obstacle)[:n]
-            length = math.sqrt(float(direction @ direction))
-            if support is None or length == 0.0:
-                normals.append(np.zeros(n))
-                offsets.append(math.inf)
+
+        def collect(o1, _o2, _data) -> bool:
+            near.append(o1)
+            return False  # keep going: every piece in the box
+
+        for k, (body, geometry) in enumerate(zip(self._bodies, self._geometries, strict=True)):
+            self._count_body(k)
+            box = self._horizon_box(k, horizon)
+            box.setTranslation(body.getTranslation())
+            near.clear()
+            self._manager.collide(box, None, collect)
+            self.counters["region_pairs"] += len(near)
+            if not near:  # open space: the clearance to everything is the better horizon
+                self.counters["distance_queries"] += 1
+                data = fcl.DistanceData()
+                self._manager.distance(body, data, fcl.defaultDistanceCallback)
+                d = max(float(data.result.min_distance), 0.0)
+                regions.append(FreeRegion.empty(n, max(horizon, d * rtol - self.clearance_atol)))
                 continue
-            normals.append(direction / length)
-            offsets.append(support(normals[-1]))
-        return FreeRegion(
-            np.array(normals).reshape(-1, n), np.array(offsets), np.array(clearances), horizon
-        )
+            normals, offsets, clearances = [], [], []
+            for obstacle in near:
+                result = fcl.DistanceResult()
+                d = fcl.distance(body, obstacle, request, result)
+                if d <= 0.0:
+                    return (FreeRegion.colliding(n),) * len(self._bodies)
+                clearances.append(max(d * rtol - self.clearance_atol, 0.0))
+                # FCL swaps the pair (and its nearest points) for some geometry types (meshes)
+                if result.o1 is geometry:
+                    piece, (p_body, p_obstacle) = result.o2, result.nearest_points
+                else:
+                    piece, (p_obstacle, p_body) = result.o1, result.nearest_points
+                support = self._support_of[id(piece)]
+                direction = (p_body - p_obstacle)[:n]
+                length = math.sqrt(float(direction @ direction))
+                if support is None or length == 0.0:
+                    normals.append(np.zeros(n))
+                    offsets.append(math.inf)
+                    continue
+                normals.append(direction / length)
+                offsets.append(support(normals[-1]))
+            regions.append(
+                FreeRegion(
+                    np.array(normals).reshape(-1, n),
+                    np.array(offsets),
+                    np.array(clearances),
+                    horizon,
+                )
+            )
+        return tuple(regions)
+
+    def _horizon_box(self, k: int, horizon: float) -> fcl.CollisionObject:
+        """The broad-phase box of body ``k`` for ``horizon`` (built once)."""
+        box = self._horizon_boxes.get((k, horizon))
+        if box is None:
+            side = 2.0 * (float(self.robot.bodies[k].semi_axes.max()) + horizon)
+            height = side if self.dimension == 3 else 4.0 * self._half_height  # every prism
+            box = fcl.CollisionObject(fcl.Box(side, side, height), fcl.Transform())
+            self._horizon_boxes[(k, horizon)] = box
+        return box
 
     def ball_collides(self, center: ArrayLike, radius: float) -> bool:
         """Whether the ball (2D: disc) of ``radius`` about ``center`` meets an obstacle
@@ -338,11 +424,13 @@ class CollisionWorld:
         return np.array([self.clearance(p) for p in P], dtype=float)
 
     def colliding_obstacles(self, pose: ArrayLike) -> list[int]:
-        """Indices of the obstacles the robot at ``pose`` touches (diagnostics; one
+        """Indices of the obstacles some body of the robot at ``pose`` touches (diagnostics; one
         narrow-phase test per FCL object, not counted)."""
         self._place(pose)
         request, hits = fcl.CollisionRequest(), []
         for obj, owner in zip(self._objects, self.owner, strict=True):
-            if owner not in hits and fcl.collide(self._robot, obj, request, fcl.CollisionResult()):
+            if owner not in hits and any(
+                fcl.collide(body, obj, request, fcl.CollisionResult()) for body in self._bodies
+            ):
                 hits.append(owner)
         return hits

@@ -1,4 +1,5 @@
-"""Triangle-mesh files for 3D obstacles: STL (binary or ASCII) and Wavefront OBJ.
+"""Triangle meshes for 3D obstacles: STL (binary or ASCII) and Wavefront OBJ files, and
+the triangulated convex hull of a point set (``convex`` obstacles).
 
 Only what FCL needs is read: vertex positions and triangles (OBJ polygons are fanned into
 triangles; normals, texture coordinates and materials are ignored). Errors are raised as
@@ -13,10 +14,11 @@ import struct
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import ConvexHull, QhullError
 
 from kcplan.files import atomic_output
 
-__all__ = ["MAX_MESH_BYTES", "MAX_MESH_TRIANGLES", "read_mesh", "write_stl"]
+__all__ = ["MAX_MESH_BYTES", "MAX_MESH_TRIANGLES", "convex_hull", "read_mesh", "write_stl"]
 
 MAX_MESH_BYTES = 256 * 2**20
 """Largest mesh file read, in bytes (a guard against exhausting memory)."""
@@ -134,3 +136,26 @@ def write_stl(path: str | os.PathLike, vertices: NDArray, triangles: NDArray) ->
         fh.write(b"kcplan binary STL".ljust(80, b" "))
         fh.write(struct.pack("<I", len(rec)))
         fh.write(rec.tobytes())
+
+
+def convex_hull(points: NDArray) -> tuple[NDArray[np.float64], NDArray[np.int32]]:
+    """The convex hull of 3D points as its vertices ``(v, 3)`` and outward-oriented
+    triangles ``(t, 3)`` indexing them.
+
+    Raises
+    ------
+    ValueError
+        When the points do not span a solid (fewer than 4, or all in one plane).
+    """
+    P = np.asarray(points, dtype=float)
+    try:
+        hull = ConvexHull(P)
+    except (QhullError, ValueError):
+        raise ValueError("expected points spanning a solid (not all in one plane)") from None
+    faces = hull.simplices.copy()
+    A, B, C = (P[faces[:, k]] for k in range(3))
+    inward = np.einsum("fi,fi->f", np.cross(B - A, C - A), hull.equations[:, :3]) < 0
+    faces[inward] = faces[inward][:, [0, 2, 1]]
+    # keep only the hull's vertices, renumbered
+    used, faces = np.unique(faces, return_inverse=True)
+    return P[used], faces.reshape(-1, 3).astype(np.int32)

@@ -1,7 +1,8 @@
-"""Where the robot's centre cannot be: grid cells proven blocked for every orientation.
+"""Where the robot's origin cannot be: grid cells proven blocked for every orientation.
 
-The robot ``E_a`` contains the ball of radius ``r = min(a)`` about its centre, whatever
-its orientation. For a cell of half-diagonal ``h < r`` centred at ``c``, every centre
+The robot contains the ball of radius ``r`` about its origin, whatever its orientation
+(its core radius, :attr:`kcplan.geometry.robot.Robot.core_radius`: ``min(a)`` for
+``E_a``). For a cell of half-diagonal ``h < r`` centred at ``c``, every centre
 ``x`` in the cell has ``B(c, r - h) ⊂ B(x, r) ⊂ E_a(x, R)``; so if the ball
 ``B(c, r - h)`` meets an obstacle (one FCL query), every robot pose with its centre in
 the cell collides, and a lookup rejects such a state with no query. The grid only ever
@@ -29,11 +30,13 @@ class CoreOccupancy:
     Parameters
     ----------
     world : kcplan.world.CollisionWorld
-        Provides ``ball_collides(center, radius)``, ``semi_axes`` and the scenario bounds.
+        Provides ``ball_collides(center, radius)``, ``robot`` and the scenario bounds.
     max_cells : int
-        Upper bound on the number of cells. Cells have half-diagonal ``min(a) / 2`` unless
-        this bound needs larger ones; when the half-diagonal would reach ``0.9 min(a)``
-        the grid is disabled (``enabled`` False: it never blocks anything).
+        Upper bound on the number of cells. Cells have half-diagonal ``r / 2`` unless
+        this bound needs larger ones, with ``r`` the robot's core radius
+        (:attr:`kcplan.geometry.robot.Robot.core_radius`, ``min(a)`` for one body at the
+        origin); when the half-diagonal would reach ``0.9 r`` the grid is disabled
+        (``enabled`` False: it never blocks anything).
 
     Attributes
     ----------
@@ -44,9 +47,9 @@ class CoreOccupancy:
     def __init__(self, world, max_cells: int = 1_000_000):
         low, high = (np.asarray(b, dtype=float) for b in world.scenario.bounds)
         n = len(low)
-        r = float(np.min(world.semi_axes))
+        r = world.robot.core_radius
         extent = np.maximum(high - low, 1e-12)
-        side = max(float(np.prod(extent) / max_cells) ** (1.0 / n), r / math.sqrt(n))
+        side = max(float(np.prod(extent) / max_cells) ** (1.0 / n), r / math.sqrt(n), 1e-12)
         half_diagonal = 0.5 * side * math.sqrt(n)
         self.world = world
         self.low, self.side, self.dimension = low.tolist(), side, n

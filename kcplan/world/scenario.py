@@ -1,8 +1,9 @@
 """Scenario files: the YAML format, its validating loader and its writer.
 
-A scenario is one planning problem: a robot ellipse (2D) or ellipsoid (3D), a box for the
-robot's centre, a start and a goal pose, and obstacles. The format is documented in
-``scenarios/README.md``. Every error names the file, the field and what was expected::
+A scenario is one planning problem: a robot made of one or more ellipses (2D) or
+ellipsoids (3D) (:class:`kcplan.geometry.robot.Robot`), a box for the robot's origin, a
+start and a goal pose, and obstacles. The format is documented in ``scenarios/README.md``.
+Every error names the file, the field and what was expected::
 
     scenarios/x.yaml: obstacles[3].box.size: expected 2 positive numbers, got [4, -1]
 
@@ -25,8 +26,9 @@ from numpy.typing import NDArray
 
 from kcplan.files import write_text_atomic
 from kcplan.geometry.pose import quaternion_matrix, wrap_angle
+from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
-from kcplan.world.mesh import read_mesh
+from kcplan.world.mesh import convex_hull, read_mesh
 from kcplan.world.polygon import convex_pieces
 
 __all__ = [
@@ -51,6 +53,8 @@ MAX_OBSTACLES = 100_000
 """Largest number of obstacles in one scenario."""
 MAX_POLYGON_VERTICES = 500
 """Largest number of vertices of one polygon (decomposition is quadratic)."""
+MAX_CONVEX_VERTICES = 20_000
+"""Largest number of points of one ``convex`` obstacle."""
 MAX_MAGNITUDE = 1e9
 """Largest absolute value of any number in a scenario; FCL crashes on values near 1e300."""
 MIN_POSITIVE = 1e-9
@@ -64,7 +68,7 @@ about 4x faster than the pure-Python one, with the same line and column in error
 
 OBSTACLE_KINDS = {
     2: ("box", "ellipse", "circle", "polygon"),
-    3: ("box", "ellipsoid", "sphere", "mesh"),
+    3: ("box", "ellipsoid", "sphere", "convex", "mesh"),
 }
 
 
@@ -80,7 +84,7 @@ class Obstacle:
     ----------
     kind : str
         ``box``, ``ellipse``, ``circle``, ``polygon`` (2D) or ``box``, ``ellipsoid``,
-        ``sphere``, ``mesh`` (3D).
+        ``sphere``, ``convex``, ``mesh`` (3D).
     index : int
         Position in the scenario's obstacle list.
     spec : dict
@@ -93,9 +97,11 @@ class Obstacle:
         Half side lengths (box), semi-axes (ellipse, ellipsoid), the radius repeated
         (circle, sphere); zeros for polygons and meshes.
     pieces : tuple of ndarray
-        Polygon: convex pieces ``(m_i, 2)`` in world coordinates; box (2D): its rectangle.
+        Polygon: convex pieces ``(m_i, 2)`` in world coordinates; box (2D): its rectangle;
+        convex: its hull's vertices ``(v, 3)``.
     vertices, triangles : ndarray or None
-        Mesh: world-frame vertices ``(v, 3)`` and triangles ``(t, 3)``.
+        Mesh and convex: world-frame vertices ``(v, 3)`` and (outward) triangles
+        ``(t, 3)``; a convex obstacle keeps only its hull.
     """
 
     kind: str
@@ -120,8 +126,8 @@ class Scenario:
 
     name: str
     dimension: int
-    bounds: NDArray[np.float64]  # shape (2, n): low, high for the robot centre
-    semi_axes: NDArray[np.float64]
+    bounds: NDArray[np.float64]  # shape (2, n): low, high for the robot's origin
+    robot: Robot
     inflation: float
     start: NDArray[np.float64]
     goal: NDArray[np.float64]
@@ -129,6 +135,12 @@ class Scenario:
     description: str = ""
     source: str = "<string>"
     directory: Path = field(default_factory=Path.cwd)
+
+    @property
+    def semi_axes(self) -> NDArray[np.float64]:
+        """The semi-axes of a one-body robot (:attr:`Robot.semi_axes`; raises
+        ``ValueError`` for a robot of several bodies)."""
+        return self.robot.semi_axes
 
 
 def _show(value: Any, limit: int = 60) -> str:
@@ -258,15 +270,40 @@ class _Reader:
         q = self.quaternion(spec.get("quaternion", [0.0, 0.0, 0.0, 1.0]), f"{where}.quaternion")
         return quaternion_matrix(q)
 
-    def pose(self, value: Any, where: str, n: int) -> NDArray:
+    def pose(self, value: Any, where: str, n: int, ignore: tuple = ()) -> NDArray:
+        """``{position, yaw | quaternion}`` as a flat pose; ``ignore`` lists other keys the
+        caller has read."""
         angle = "yaw" if n == 2 else "quaternion"
-        spec = self.mapping(value, where, ("position",), (angle,))
+        spec = self.mapping(value, where, ("position",), (angle, *ignore))
         position = self.vector(spec["position"], f"{where}.position", n)
         if n == 2:  # OMPL's SO(2) holds [-pi, pi]: a yaw of 7.0 would be an invalid state
             yaw = float(wrap_angle(self.number(spec.get("yaw", 0.0), f"{where}.yaw")))
             return np.append(position, yaw)
         q = self.quaternion(spec.get("quaternion", [0.0, 0.0, 0.0, 1.0]), f"{where}.quaternion")
         return np.concatenate([position, q])
+
+
+def _robot(r: _Reader, value: Any, n: int) -> tuple[Robot, float]:
+    """The ``robot`` mapping: the robot (``semi_axes``: one body at the origin, or
+    ``bodies``) and its guard inflation."""
+    spec = r.mapping(value, "robot", (), ("semi_axes", "bodies", "inflation"))
+    if ("semi_axes" in spec) == ("bodies" in spec):
+        r.fail("robot", "exactly one of semi_axes (one body) and bodies (a list)", value)
+    inflation = r.number(spec.get("inflation", DEFAULT_INFLATION), "robot.inflation", True)
+    if "semi_axes" in spec:
+        return Robot.single(r.vector(spec["semi_axes"], "robot.semi_axes", n, True)), inflation
+    items = spec["bodies"]
+    if not isinstance(items, list) or not items or len(items) > MAX_BODIES:
+        r.fail("robot.bodies", f"a list of 1 to {MAX_BODIES} bodies", items)
+    angle = "yaw" if n == 2 else "quaternion"
+    bodies = []
+    for i, item in enumerate(items):
+        where = f"robot.bodies[{i}]"
+        body = r.mapping(item, where, ("semi_axes",), ("position", angle))
+        axes = r.vector(body["semi_axes"], f"{where}.semi_axes", n, positive=True)
+        pose = r.pose({"position": [0.0] * n} | body, where, n, ignore=("semi_axes",))
+        bodies.append(Body(axes, pose))
+    return Robot(bodies), inflation
 
 
 def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Obstacle:
@@ -321,6 +358,24 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
         except ValueError as err:
             raise ScenarioError(f"{r.source}: {where}.vertices: {err}") from None
         return Obstacle(kind, index, spec, pts.mean(axis=0), eye, zeros, pieces)
+    if kind == "convex":
+        spec = r.mapping(spec, where, ("vertices",), ("position", "quaternion"))
+        points = spec["vertices"]
+        if not isinstance(points, list) or not 4 <= len(points) <= MAX_CONVEX_VERTICES:
+            r.fail(
+                f"{where}.vertices",
+                f"a list of 4 to {MAX_CONVEX_VERTICES} points [x, y, z]",
+                points,
+                f"{len(points)} points" if isinstance(points, list) else None,
+            )
+        local = np.array([r.vector(v, f"{where}.vertices[{i}]", 3) for i, v in enumerate(points)])
+        position = r.vector(spec.get("position", [0.0, 0.0, 0.0]), f"{where}.position", 3)
+        R = r.rotation(spec, where, 3)
+        try:
+            vertices, triangles = convex_hull(position + local @ R.T)
+        except ValueError as err:
+            raise ScenarioError(f"{r.source}: {where}.vertices: {err}") from None
+        return Obstacle(kind, index, spec, position, R, zeros, (vertices,), vertices, triangles)
     # mesh
     spec = r.mapping(spec, where, ("file",), ("scale", "position", "quaternion"))
     name = r.text(spec["file"], f"{where}.file")
@@ -383,11 +438,7 @@ def parse_scenario(
     low, high = r.vector(b["low"], "bounds.low", n), r.vector(b["high"], "bounds.high", n)
     if not (low < high).all():
         r.fail("bounds", "low < high in every coordinate", top["bounds"])
-    robot = r.mapping(top["robot"], "robot", ("semi_axes",), ("inflation",))
-    semi_axes = r.vector(robot["semi_axes"], "robot.semi_axes", n, positive=True)
-    inflation = r.number(
-        robot.get("inflation", DEFAULT_INFLATION), "robot.inflation", positive=True
-    )
+    robot, inflation = _robot(r, top["robot"], n)
     poses = {}
     for key in ("start", "goal"):
         pose = r.pose(top[key], key, n)
@@ -410,7 +461,7 @@ def parse_scenario(
         name,
         n,
         np.stack([low, high]),
-        semi_axes,
+        robot,
         inflation,
         poses["start"],
         poses["goal"],
@@ -493,7 +544,7 @@ def scenario_to_dict(scenario: Scenario) -> dict:
     out |= {
         "dimension": n,
         "bounds": {"low": scenario.bounds[0].tolist(), "high": scenario.bounds[1].tolist()},
-        "robot": {"semi_axes": scenario.semi_axes.tolist(), "inflation": scenario.inflation},
+        "robot": scenario.robot.to_spec() | {"inflation": scenario.inflation},
         "start": pose(scenario.start),
         "goal": pose(scenario.goal),
         "obstacles": [{o.kind: o.spec} for o in scenario.obstacles],

@@ -21,7 +21,8 @@ __all__ = ["PointsSupport", "BallSupport", "EllipsoidSupport", "box_vertices", "
 
 
 class PointsSupport:
-    """Convex hull of points (polygon pieces, boxes): ``h(n) = max_i v_i . n``.
+    """Convex hull of points (polygon pieces, boxes, convex obstacles):
+    ``h(n) = max_i v_i . n``.
 
     Parameters
     ----------
@@ -84,6 +85,8 @@ def piece_supports(obstacle) -> list:
     kind, n = obstacle.kind, len(obstacle.center)
     if kind in ("polygon", "box") and n == 2:
         return [PointsSupport(p) for p in obstacle.pieces]
+    if kind == "convex":
+        return [PointsSupport(obstacle.vertices)]
     if kind == "box":
         return [PointsSupport(box_vertices(obstacle.center, obstacle.rotation, obstacle.extents))]
     if kind in ("circle", "sphere"):

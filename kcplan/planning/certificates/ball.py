@@ -24,6 +24,17 @@ where ``L`` bounds how fast ``|A R^T n|`` changes per radian of rotation about a
 
 Along an OMPL edge ``|t(s) - t(m)| = |s - m| |dt|`` and the rotation angle is
 ``|s - m| |w|``, so the ball covers ``|s - m| <= d / (|dt| + L |w|)`` on both sides.
+
+Several bodies (:mod:`kcplan.geometry.robot`). Body ``k`` with centre ``p_k`` in the
+robot frame has ``h_k(n) = n . (t + R p_k) + |A_k R_k^T R^T n|``. Rotating the robot by
+``phi`` about its origin moves ``R p_k`` along an arc, by a chord of at most
+``|p_k| phi``, so ``n . R p_k`` changes by at most ``|p_k| phi``; the last term changes
+by at most ``(a_max,k - a_min,k) phi`` as above. With body ``k``'s own clearance
+``d_k``, body ``k`` stays free while ``|s - m| (|dt| + L_k |w|) <= d_k`` with
+``L_k = |p_k| + a_max,k - a_min,k`` (``rotation``) or ``|p_k| + a_max,k`` (``ball``:
+every point of the body lies within that distance of the origin), and the edge is
+covered where every body is: the minimum over bodies. One body at the origin gives the
+levers above.
 """
 
 from __future__ import annotations
@@ -33,27 +44,34 @@ import math
 from numpy.typing import ArrayLike
 
 from kcplan.geometry.pose import Edge
+from kcplan.geometry.robot import Robot
 from kcplan.planning.guard import Guard
 
 __all__ = ["ClearanceBall"]
 
 
 class ClearanceBall:
-    """Conservative advancement with a clearance ball (see the module docstring).
+    """Conservative advancement with a clearance ball per body (see the module docstring).
 
     Parameters
     ----------
-    semi_axes : array_like, shape (n,)
+    robot : Robot or array_like
+        The robot, or the semi-axes ``(n,)`` of one body at the origin.
     rotation_aware : bool
-        Lever ``max(a) - min(a)`` (name ``rotation``) instead of ``max(a)`` (``ball``).
+        Levers ``|p_k| + a_max,k - a_min,k`` (name ``rotation``) instead of
+        ``|p_k| + a_max,k`` (``ball``).
     """
 
-    def __init__(self, semi_axes: ArrayLike, rotation_aware: bool = False):
-        a = [float(v) for v in semi_axes]
-        self.lever = max(a) - min(a) if rotation_aware else max(a)
+    def __init__(self, robot: Robot | ArrayLike, rotation_aware: bool = False):
+        robot = Robot.of(robot)
+        self.levers = robot.levers if rotation_aware else tuple(b.reach for b in robot.bodies)
         self.name = "rotation" if rotation_aware else "ball"
 
     def reach(self, guard: Guard, edge: Edge, m: float) -> tuple[float, float]:
-        speed = edge.translation_speed + self.lever * edge.rotation_speed
-        r = guard.clearance / speed if speed > 0.0 else math.inf
+        r = math.inf
+        v, w = edge.translation_speed, edge.rotation_speed
+        for body, lever in zip(guard.bodies, self.levers, strict=True):
+            speed = v + lever * w
+            if speed > 0.0:
+                r = min(r, body.clearance / speed)
         return r, r

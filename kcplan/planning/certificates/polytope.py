@@ -8,6 +8,10 @@ coordinates of ``q(s)`` are ``(s - m) direction(m)`` (design notes, Sec. 4), a l
 through the origin, so the guard covers ``[m - lam-, m + lam+]`` with ``lam+-`` the gauge
 of ``P_eps`` along ``+-direction(m)`` (:meth:`GuardLadder.reach`). The ladder holds
 polytopes for a few inflations; the largest one the clearance allows is used.
+
+The polytope is the paper's bound for one ellipsoid ``E_a`` centred at the robot's
+origin; for a robot of several bodies :class:`kcplan.planning.certifier.EdgeCertifier`
+refuses it.
 """
 
 from __future__ import annotations
