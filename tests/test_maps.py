@@ -9,7 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from kcplan.cli import main
-from kcplan.maps.hrm import HRM_MAPS
+from kcplan.geometry.pose import quaternion_matrix
+from kcplan.maps.hrm import HRM_MAPS, _axis_angle_quaternion
 from kcplan.maps.movingai import (
     free_square_sizes,
     merge_rectangles,
@@ -38,6 +39,17 @@ needs_mapf = pytest.mark.skipif(
     not MAPF.is_dir(), reason=f"Moving AI maps not found at {MAPF} (../shared/data/external)"
 )
 HRM_2D, HRM_3D = HRM_MAPS[2], HRM_MAPS[3]
+HRM_PROBLEMS = (
+    [(m, 2, "single_body") for m in HRM_2D if m != "superellipse_maze3"]
+    + [("superellipse_maze1", 2, "rabbit"), ("ellipse_sparse", 2, "S_shape")]
+    + [("ellipsoid_cluttered", 3, "chair"), ("ellipsoid_maze", 3, "snake")]
+    + [("ellipsoid_sparse", 3, "chair"), ("superquadrics_sparse", 3, "rabbit2")]
+    + [(f"superquadrics_{m}", 3, "rabbit") for m in ("cluttered", "maze", "narrow")]
+    + [("superquadrics_home", 3, "tree")]
+)
+"""Map and robot pairs whose start and goal are free (HRM's settings are per map, not per
+robot: e.g. the rabbit's body sticks out of the arena at the start of superquadrics_sparse
+in HRM's own geometry)."""
 MAPF_MAPS = ["maze-32-32-2", "maze-32-32-4", "room-32-32-4", "random-32-32-10", "maze-128-128-10"]
 
 
@@ -124,12 +136,11 @@ def test_point_triangle_distance_closed_forms():
 
 
 @needs_hrm
-@pytest.mark.parametrize("name, dimension", [(m, 2) for m in HRM_2D] + [(m, 3) for m in HRM_3D])
-def test_every_hrm_map_converts_and_validates(name, dimension, tmp_path, capsys):
+@pytest.mark.parametrize("name, dimension, robot", HRM_PROBLEMS)
+def test_every_hrm_map_converts_and_validates(name, dimension, robot, tmp_path, capsys):
     out = tmp_path / f"{name}.yaml"
-    code = main(
-        ["import", "hrm", str(HRM), "--map", name, "--dimension", str(dimension), "-o", str(out)]
-    )
+    args = ["--map", name, "--dimension", str(dimension), "--robot", robot, "-o", str(out)]
+    code = main(["import", "hrm", str(HRM), *args])
     assert code == 0, capsys.readouterr().err
     assert main(["validate", str(out)]) == 0
     scenario = load_scenario(out)
@@ -153,6 +164,18 @@ def test_every_hrm_map_converts_and_validates(name, dimension, tmp_path, capsys)
             pts = local @ R.T + c
             tiny = CollisionWorld(scenario, [1e-6, 1e-6])
             assert all(tiny.in_collision(np.array([x, y, 0.0])) for x, y in pts)
+        else:
+            a, e, c = row[:3], tuple(row[3:5]), row[5:8]
+            u = rng.normal(size=(60, 3))
+            local, _ = support_points(u / np.linalg.norm(u, axis=1, keepdims=True), a, e)
+            local *= rng.uniform(0.2, 1.0, (60, 1)) ** 0.5
+            R = quaternion_matrix(_axis_angle_quaternion(row[8:11], row[11]))
+            tiny = CollisionWorld(scenario, [1e-6] * 3)
+            unit = [0.0, 0.0, 0.0, 1.0]
+            assert all(tiny.in_collision(np.array([*p, *unit])) for p in local @ R.T + c)
+    assert len(robot_rows(HRM / f"{dimension}D" / f"robot_{robot}_{dimension}D.csv")) == len(
+        scenario.robot
+    )
     assert len(data["obstacles"]) >= len(obstacles)
     del world
 
@@ -174,8 +197,15 @@ def test_hrm_arena_keeps_the_robot_inside(tmp_path):
 
 
 @needs_hrm
-@pytest.mark.parametrize("name, dimension", [("ellipse_maze", 2), ("ellipsoid_cluttered", 3)])
-def test_plan_on_converted_hrm_maps(name, dimension, tmp_path):
+@pytest.mark.parametrize(
+    "name, dimension, robot",
+    [
+        ("ellipse_maze", 2, "single_body"),
+        ("superellipse_sparse", 2, "rabbit"),
+        ("superquadrics_cluttered", 3, "rabbit"),
+    ],
+)
+def test_plan_on_converted_hrm_maps(name, dimension, robot, tmp_path):
     out = tmp_path / f"{name}.yaml"
     assert (
         main(
@@ -187,6 +217,8 @@ def test_plan_on_converted_hrm_maps(name, dimension, tmp_path):
                 name,
                 "--dimension",
                 str(dimension),
+                "--robot",
+                robot,
                 "-o",
                 str(out),
             ]
@@ -199,6 +231,30 @@ def test_plan_on_converted_hrm_maps(name, dimension, tmp_path):
     assert not verify_path(CollisionWorld(scenario), result.states).collides
 
 
+def robot_rows(path):
+    return np.loadtxt(path, delimiter=",", ndmin=2)
+
+
+@needs_hrm
+@pytest.mark.parametrize(
+    "name, dimension, robot, field",
+    [
+        ("superquadrics_sparse", 3, "rabbit", "start"),
+        ("superquadrics_home", 3, "chair", "start"),
+        ("superellipse_maze3", 2, "single_body", "goal"),
+    ],
+)
+def test_hrm_settings_in_collision_are_refused(name, dimension, robot, field, tmp_path, capsys):
+    """HRM's own settings put these robots in collision (checked independently with the
+    exact superquadric level in the closing note of issue 13): one line, exit 2, no file."""
+    out = tmp_path / "x.yaml"
+    args = ["--map", name, "--dimension", str(dimension), "--robot", robot, "-o", str(out)]
+    assert main(["import", "hrm", str(HRM), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert f"{field}: the robot collides with obstacles[" in err and "\n" not in err
+    assert not out.exists()
+
+
 @needs_hrm
 def test_hrm_import_errors(tmp_path, capsys):
     out = str(tmp_path / "x.yaml")
@@ -207,6 +263,11 @@ def test_hrm_import_errors(tmp_path, capsys):
     assert "ambiguous" in err and "ellipse_cluttered" in err and len(err.strip().splitlines()) == 1
     assert main(["import", "hrm", str(tmp_path), "--map", "maze", "-o", out]) == 2
     assert "unknown map" in capsys.readouterr().err
+    assert (
+        main(["import", "hrm", str(HRM), "--map", "ellipse_maze", "--robot", "cat", "-o", out]) == 2
+    )
+    err = capsys.readouterr().err
+    assert "--robot: unknown robot 'cat' for dimension 2; expected one of NAO_silhouette" in err
     assert not Path(out).exists()
 
 
