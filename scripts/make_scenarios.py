@@ -54,15 +54,18 @@ def slab_with_hole(x0, x1, y0, y1, z0, z1, lo, hi) -> list[dict]:
     ]
 
 
-def scenario(name, description, n, low, high, start, goal, obstacles, a=None, eps=None) -> dict:
+def scenario(
+    name, description, n, low, high, start, goal, obstacles, a=None, eps=None, bodies=None
+) -> dict:
     a = a or (A2 if n == 2 else A3)
     eps = eps or (EPS2 if n == 2 else EPS3)
+    robot = {"bodies": bodies} if bodies else {"semi_axes": a}
     return {
         "name": name,
         "description": description,
         "dimension": n,
         "bounds": {"low": low, "high": high},
-        "robot": {"semi_axes": a, "inflation": eps},
+        "robot": robot | {"inflation": eps},
         "start": start,
         "goal": goal,
         "obstacles": obstacles,
@@ -306,6 +309,33 @@ def l_turn() -> dict:
     )
 
 
+def l_robot_door() -> dict:
+    """The two-ellipse L of issue 13 through a door 7.6 wide: across the door the L is
+    6.8 wide only when its long body points along the corridor."""
+    bodies = [
+        {"semi_axes": [5.0, 1.2], "position": [0.0, 0.0], "yaw": 0.0},
+        {"semi_axes": [3.0, 1.2], "position": [-3.8, 2.6], "yaw": r(math.pi / 2)},
+    ]
+    obstacles = [
+        box([49, 0], [51, 25.6]),
+        box([49, 33.2], [51, 60]),
+        box([20, 40], [30, 60]),
+        {"circle": {"center": [75, 18], "radius": 6}},
+    ]
+    return scenario(
+        "l_robot_door",
+        "a robot of two ellipses (an L, 10 x 6.8) through a door 7.6 wide in a wall 2 thick: "
+        "it must turn from pointing up to pointing along the corridor, pass, and turn down",
+        2,
+        [0, 0],
+        [100, 60],
+        pose2(12, 22, math.pi / 2),
+        pose2(88, 40, -math.pi / 2),
+        obstacles,
+        bodies=bodies,
+    )
+
+
 def thin_wall() -> dict:
     obstacles = [box([99.95, 0], [100.05, 185]), box([99.95, 195], [100.05, 200])]
     return scenario(
@@ -507,6 +537,7 @@ SUITE = {
         random_clutter,
         l_turn,
         thin_wall,
+        l_robot_door,
     ],
     "3d": [window_wall, box_field, narrow_tunnel, peg_in_hole, open_space],
 }

@@ -12,9 +12,12 @@ from kcplan.geometry.containment import (
 )
 from kcplan.geometry.ellipsoid import as_inflation, as_semi_axes, guard_semi_axes
 from kcplan.geometry.minkowski import centred_margin, radial_extent, sphere_frames
+from kcplan.geometry.robot import Body, Robot
 from kcplan.geometry.rotations import exp_rotation, hat, kc_dimension, log_rotation
 
 __all__ = [
+    "Body",
+    "Robot",
     "as_inflation",
     "as_semi_axes",
     "centred_margin",
