@@ -1,11 +1,16 @@
-"""kcplan: motion planning for ellipsoidal robots with edges certified by the
+"""kcplan: motion planning for robots made of ellipsoids, with edges certified by the
 Kinematics of Containment (Ruan, Ding, Ma, Chirikjian).
+
+>>> from kcplan import load_scenario, plan
+>>> result = plan(load_scenario("scenarios/2d/l_turn.yaml"), time_limit=5, seed=1)
+>>> result.solved, result.verify().collides
+(True, False)
 
 KC coordinates are ``xi = [theta, x, y]`` (2D) and ``xi = [w1, w2, w3, x, y, z]`` (3D):
 the robot's pose relative to its guard, rotation as exponential coordinates.
 """
 
-from kcplan.geometry import containment_margin, first_order_margin
+from kcplan.geometry import Robot, containment_margin, first_order_margin
 from kcplan.kc import ConvexLowerBound, GeometricLowerBound, kc_volume
 
 __version__ = "0.1.0"
@@ -14,7 +19,10 @@ __all__ = [
     "CollisionWorld",
     "ConvexLowerBound",
     "KCMotionValidator",
+    "PlanResult",
+    "Robot",
     "load_scenario",
+    "plan",
     "GeometricLowerBound",
     "containment_margin",
     "first_order_margin",
@@ -28,6 +36,10 @@ def __getattr__(name: str):
         from kcplan.planning.validator import KCMotionValidator
 
         return KCMotionValidator
+    if name in ("plan", "PlanResult"):
+        import kcplan.planning.problem
+
+        return getattr(kcplan.planning.problem, name)
     if name in ("CollisionWorld", "load_scenario"):
         import kcplan.world
 

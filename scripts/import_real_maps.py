@@ -1,7 +1,9 @@
-"""Convert the HRM benchmark maps used in benchmarks/RESULTS.md into a local folder.
+"""Convert the HRM benchmark problems used in benchmarks/RESULTS.md into a local folder.
 
 HRM's maps are GPL-3.0 data, so their conversions are not committed; this script
-recreates them (2D and 3D sparse, cluttered and maze, plus the 2D superellipse maps)::
+recreates them: the 2D single-body maps of section 4 and the multi-body problems of the
+HRM comparison (section 6: HRM's 3D superquadric maps with the rabbit, rabbit2 and tree,
+the 2D superellipse map with the rabbit and the S shape)::
 
     python scripts/import_real_maps.py [--hrm ../shared/data/external/hrm/resources] \
         [--out build/hrm]
@@ -15,15 +17,19 @@ from pathlib import Path
 
 from kcplan.cli import main as kcplan
 
-MAPS = [
-    ("ellipse_sparse", 2),
-    ("ellipse_cluttered", 2),
-    ("ellipse_maze", 2),
-    ("superellipse_cluttered", 2),
-    ("superellipse_maze1", 2),
-    ("ellipsoid_sparse", 3),
-    ("ellipsoid_cluttered", 3),
-    ("ellipsoid_maze", 3),
+MAPS = [  # (file stem, HRM map, dimension, HRM robot)
+    ("hrm_ellipse_sparse_2d", "ellipse_sparse", 2, "single_body"),
+    ("hrm_ellipse_cluttered_2d", "ellipse_cluttered", 2, "single_body"),
+    ("hrm_ellipse_maze_2d", "ellipse_maze", 2, "single_body"),
+    ("hrm_superellipse_cluttered_2d", "superellipse_cluttered", 2, "single_body"),
+    ("hrm_superellipse_maze1_2d", "superellipse_maze1", 2, "single_body"),
+    ("sparse_rabbit2", "superquadrics_sparse", 3, "rabbit2"),
+    ("cluttered_rabbit", "superquadrics_cluttered", 3, "rabbit"),
+    ("maze_rabbit", "superquadrics_maze", 3, "rabbit"),
+    ("narrow_rabbit", "superquadrics_narrow", 3, "rabbit"),
+    ("home_tree", "superquadrics_home", 3, "tree"),
+    ("cluttered_rabbit_2d", "superellipse_cluttered", 2, "rabbit"),
+    ("cluttered_S_2d", "superellipse_cluttered", 2, "S_shape"),
 ]
 
 
@@ -35,11 +41,10 @@ def main() -> int:
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    for name, dim in MAPS:
-        target = out / f"hrm_{name}_{dim}d.yaml"
-        code = kcplan(
-            ["import", "hrm", args.hrm, "--map", name, "--dimension", str(dim), "-o", str(target)]
-        )
+    for stem, name, dim, robot in MAPS:
+        target = out / f"{stem}.yaml"
+        options = ["--map", name, "--dimension", str(dim), "--robot", robot, "-o", str(target)]
+        code = kcplan(["import", "hrm", args.hrm, *options])
         if code:
             return code
     return 0

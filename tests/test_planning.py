@@ -268,3 +268,20 @@ def test_ladder_reach_is_the_gauge():
         assert bound.contains(0.999 * plus * v) and not bound.contains(1.001 * plus * v)
     assert ladder.level_for(0.08 * 5.0) == 0 and ladder.level_for(0.079 * 5.0) == -1
     assert math.isinf(ladder.reach(0, np.zeros(3))[0])
+
+
+def test_python_entry_point_plans_and_verifies():
+    """``from kcplan import plan, load_scenario`` as the README shows, on the two-body L."""
+    from kcplan import load_scenario as load
+    from kcplan import plan as plan_from_package
+
+    scenario = load(ROOT / "scenarios" / "2d" / "l_robot_door.yaml")
+    result = plan_from_package(scenario, planner="kc-rrtconnect", time_limit=5, seed=1)
+    assert result.solved and len(scenario.robot) == 2
+    check = result.verify()
+    assert not check.collides and check.queries > len(result.states)
+    assert result.counters["kc_edges"] > 0 and "problem" not in result.to_json()
+    unsolved = plan_from_package(scenario, planner="kc-rrtconnect", time_limit=1e-6, seed=1)
+    if not unsolved.solved:
+        with pytest.raises(ValueError, match="expected a solved plan"):
+            unsolved.verify()

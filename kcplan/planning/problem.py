@@ -18,6 +18,7 @@ from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.names import PLANNER_NAMES
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
+from kcplan.planning.verify import PathCheck, verify_path
 from kcplan.world.collision import CollisionWorld
 from kcplan.world.scenario import Scenario
 
@@ -133,6 +134,22 @@ class PlanResult:
     raw_length: float = 0.0  # the same, of the path solve() returned, before simplification
     seed: int | None = None
     counters: dict = field(default_factory=dict)
+    problem: Scenario | None = field(default=None, repr=False, compare=False)
+    """The scenario planned on (for :meth:`verify`; not written to JSON)."""
+
+    def verify(self, tolerance: float = 1e-6) -> PathCheck:
+        """Check the path without gaps, independently of every certificate
+        (:func:`kcplan.planning.verify.verify_path`: FCL clearances and conservative
+        advancement). ``tolerance`` is in the scenario's length unit.
+
+        Raises
+        ------
+        ValueError
+            When there is no path (not solved) or no scenario to check it against.
+        """
+        if not self.solved or self.problem is None:
+            raise ValueError(f"verify: expected a solved plan, got {self.planner} not solved")
+        return verify_path(CollisionWorld(self.problem), self.states, tolerance)
 
     def to_json(self) -> dict:
         """The ``PATH.json`` document of ``kcplan plan``."""
@@ -267,4 +284,5 @@ def plan(
         raw_length,
         seed,
         counters,
+        scenario,
     )

@@ -1,0 +1,83 @@
+"""What every ``kcplan`` subcommand shares: one-line input errors and argument types."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "InputError",
+    "Parser",
+    "finite_float",
+    "load_input",
+    "output_file",
+    "positive_float",
+    "positive_int",
+]
+
+
+class InputError(Exception):
+    """Bad user input; reported as one line with exit code 2."""
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one :class:`InputError` line, no usage dump."""
+
+    def error(self, message: str) -> None:
+        raise InputError(f"{self.prog}: {message}")
+
+
+def output_file(path: str | None, option: str, suffixes: tuple[str, ...] = ()) -> None:
+    """Refuse an output file before any work: its folder must exist (no lost plan)."""
+    if path is None:
+        return
+    out = Path(path)
+    if suffixes and out.suffix.lower() not in suffixes:
+        raise InputError(
+            f"{out}: {option}: expected a {' or '.join(suffixes)} file name, got {out.name!r}"
+        )
+    if not out.parent.is_dir():
+        raise InputError(
+            f"{out}: {option}: expected a file in an existing folder, got {out.parent}"
+        )
+    if out.is_dir():
+        raise InputError(f"{out}: {option}: expected a file name, got a folder")
+
+
+def load_input(path: str, check: bool = True):
+    """Load a scenario, turning every problem with it into an :class:`InputError`."""
+    from kcplan.world import ScenarioError, load_scenario
+
+    try:
+        return load_scenario(path, check=check)
+    except ScenarioError as err:
+        raise InputError(str(err)) from None
+
+
+def positive_float(text: str) -> float:
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value

@@ -1,0 +1,109 @@
+"""``kcplan plan``: plan a path, print its counters, write it and its picture."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from kcplan.cli.common import load_input, output_file, positive_float
+
+
+def _print_counters(counters: dict) -> None:
+    keys = [
+        "fcl_queries",
+        "collision_queries",
+        "distance_queries",
+        "region_queries",
+        "region_pairs",
+        "checker_calls",
+    ]
+    print("fcl queries     : " + ", ".join(f"{k} {counters[k]}" for k in keys if k in counters))
+    kc = {k[3:]: v for k, v in counters.items() if k.startswith("kc_")}
+    if kc:
+        print("kc validator    : " + ", ".join(f"{k} {v}" for k, v in kc.items()))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Plan, print the result and counters, write ``-o`` and ``--plot``; exit 1 when not solved."""
+    output_file(args.output, "-o")
+    output_file(args.plot, "--plot", (".png",))
+    scenario = load_input(args.scenario)
+    from kcplan.planning.problem import plan
+
+    result = plan(scenario, args.planner, args.time, args.seed, args.simplify)
+    status = "solved" if result.solved else "NOT solved"
+    print(
+        f"{scenario.name}: {status} by {args.planner} in {result.time:.3f} s "
+        f"(simplification {result.simplify_time:.3f} s)"
+    )
+    if result.solved:
+        print(f"path            : {len(result.states)} states, length {result.length:.4g}")
+    _print_counters(result.counters)
+    if args.output:
+        from kcplan.files import write_text_atomic
+
+        write_text_atomic(args.output, json.dumps(result.to_json(), indent=1) + "\n")
+        print(f"path written to {args.output}")
+    if args.plot:
+        from kcplan.viz import plot_path
+
+        guards = None
+        if args.guards and result.solved:
+            guards = path_guards(scenario, result.states)
+        plot_path(
+            scenario,
+            result.states,
+            args.plot,
+            guards=guards,
+            title=f"{scenario.name}: {args.planner}, {status}",
+        )
+        print(f"plot written to {args.plot}")
+    return 0 if result.solved else 1
+
+
+def path_guards(scenario, states) -> list:
+    """The guards (pose, inflation) that certify each edge of a path, for plotting."""
+    from kcplan.planning.certifier import EdgeCertifier
+    from kcplan.world import CollisionWorld
+
+    certifier = EdgeCertifier(CollisionWorld(scenario))
+    certifier.guard_log = []
+    for p, q in zip(states[:-1], states[1:], strict=True):
+        certifier.check(p, q)
+    return certifier.guard_log
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """Register ``kcplan plan`` on the subcommand parsers ``sub``."""
+    from kcplan.planning.names import PLANNER_NAMES
+
+    p = sub.add_parser(
+        "plan",
+        help="plan a path with a stock OMPL planner, with or without KC certificates",
+        description="Plan from start to goal. Exit 0 solved, 1 not solved in time, 2 bad input.",
+    )
+    p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
+    p.add_argument(
+        "--planner",
+        default="kc-rrtconnect",
+        choices=PLANNER_NAMES,
+        help="planner (default kc-rrtconnect)",
+    )
+    p.add_argument(
+        "--time",
+        type=positive_float,
+        default=10.0,
+        metavar="SECONDS",
+        help="planning time limit (default 10)",
+    )
+    p.add_argument("--seed", type=int, help="OMPL random seed, for reproducible runs")
+    p.add_argument(
+        "--simplify",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="simplify the path (every new edge is validated again; default on)",
+    )
+    p.add_argument("-o", "--output", metavar="PATH.json", help="write the path as JSON")
+    p.add_argument("--plot", metavar="FILE.png", help="draw the map and the path")
+    p.add_argument("--guards", action="store_true", help="also draw the guards certifying the path")
+    p.set_defaults(handler=run)
