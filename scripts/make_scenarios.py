@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from kcplan.world import dump_scenario, load_scenario
 from kcplan.world.mesh import write_stl
-from kcplan.world.scenario import dump_scenario, load_scenario
 
 A2, EPS2 = [5.0, 3.5], 0.08
 A3, EPS3 = [4.0, 2.5, 2.0], 0.1

@@ -10,6 +10,7 @@ or temporary file behind.
 import contextlib
 import io
 import json
+import tempfile
 from pathlib import Path
 
 from hypothesis import HealthCheck, given, settings
@@ -115,7 +116,8 @@ def command_lines(draw, folder: Path) -> tuple[list[str], list[Path]]:
         argv += ["-o", an_output("json" if draw(st.booleans()) else "png")]
         return argv, outputs
     argv += [a_file() for _ in range(POSITIONAL[command])]
-    for option in draw(st.lists(st.sampled_from(sorted(OPTIONS[command])), max_size=4)):
+    names = sorted(OPTIONS[command])
+    for option in draw(st.lists(st.sampled_from(names), max_size=4)) if names else []:
         value = OPTIONS[command][option]
         argv.append(option)
         if isinstance(value, str):
@@ -134,14 +136,14 @@ def command_lines(draw, folder: Path) -> tuple[list[str], list[Path]]:
 
 
 @settings(
-    max_examples=60,
+    max_examples=150,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(data=st.data())
 def test_every_command_line_ends_cleanly(data, tmp_path):
-    folder = tmp_path / f"case{data.draw(st.integers(0, 10**9))}"
-    (folder / "out").mkdir(parents=True)
+    folder = Path(tempfile.mkdtemp(dir=tmp_path))  # a fresh folder per example
+    (folder / "out").mkdir()
     argv, outputs = data.draw(command_lines(folder))
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

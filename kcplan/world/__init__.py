@@ -4,14 +4,13 @@ Independent of OMPL; the only module that imports python-fcl is :mod:`.collision
 """
 
 from kcplan.world.collision import CollisionWorld
+from kcplan.world.loading import check_start_goal, load_scenario, parse_scenario
 from kcplan.world.scenario import (
     DEFAULT_INFLATION,
     Obstacle,
     Scenario,
     ScenarioError,
     dump_scenario,
-    load_scenario,
-    parse_scenario,
     scenario_to_dict,
 )
 
@@ -21,6 +20,7 @@ __all__ = [
     "Obstacle",
     "Scenario",
     "ScenarioError",
+    "check_start_goal",
     "dump_scenario",
     "load_scenario",
     "parse_scenario",

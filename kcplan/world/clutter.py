@@ -90,4 +90,4 @@ def random_scenario(
         "goal": {"position": [1] + [0] * (n - 1)},
         "obstacles": random_obstacles(rng, n, count, half_width - 5.0),
     }
-    return parse_scenario(data, check=False)
+    return parse_scenario(data)

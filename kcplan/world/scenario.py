@@ -398,10 +398,9 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
     return Obstacle(kind, index, spec, position, R, zeros, (), world, triangles)
 
 
-def parse_scenario(
-    data: Any, source: str = "<string>", directory: Path | None = None, check: bool = True
-) -> Scenario:
-    """Validate parsed YAML and build a :class:`Scenario`.
+def parse_scenario(data: Any, source: str = "<string>", directory: Path | None = None) -> Scenario:
+    """Validate parsed YAML and build a :class:`Scenario` (the format only: whether the
+    start and goal are free is checked by :func:`kcplan.world.loading.parse_scenario`).
 
     Parameters
     ----------
@@ -411,8 +410,6 @@ def parse_scenario(
         Name used at the start of error messages (normally the file path).
     directory : Path, optional
         Directory that mesh paths are relative to (default: the working directory).
-    check : bool
-        Also reject a start or goal in collision (builds a :class:`CollisionWorld`).
 
     Raises
     ------
@@ -470,27 +467,17 @@ def parse_scenario(
         source,
         directory,
     )
-    if check:
-        from kcplan.world.collision import CollisionWorld
-
-        world = CollisionWorld(scenario)
-        for key in ("start", "goal"):
-            hits = world.colliding_obstacles(poses[key])
-            if hits:
-                labels = ", ".join(scenario.obstacles[i].label for i in hits[:3])
-                raise ScenarioError(f"{source}: {key}: the robot collides with {labels}")
     return scenario
 
 
-def load_scenario(path: str | os.PathLike, check: bool = True) -> Scenario:
-    """Read and validate a scenario file.
+def load_scenario(path: str | os.PathLike) -> Scenario:
+    """Read and validate a scenario file (the format only; see
+    :func:`kcplan.world.loading.load_scenario` for the start and goal check).
 
     Parameters
     ----------
     path : path-like
         A YAML file in the format of ``scenarios/README.md``.
-    check : bool
-        Also reject a start or goal in collision (see :func:`parse_scenario`).
 
     Raises
     ------
@@ -523,7 +510,7 @@ def load_scenario(path: str | os.PathLike, check: bool = True) -> Scenario:
         raise ScenarioError(f"{source}: {where}YAML syntax error: {problem}") from None
     except (yaml.YAMLError, RecursionError) as err:
         raise ScenarioError(f"{source}: YAML syntax error: {type(err).__name__}") from None
-    return parse_scenario(data, source, p.resolve().parent, check)
+    return parse_scenario(data, source, p.resolve().parent)
 
 
 def scenario_to_dict(scenario: Scenario) -> dict:

@@ -1,0 +1,57 @@
+"""Loading a scenario for planning: parse it, then check its start and goal in the world.
+
+:mod:`kcplan.world.scenario` reads and validates the file alone (it never needs FCL);
+this module adds the one check that does, that the robot at the start and at the goal
+touches no obstacle, so that the format and the collision world depend on each other in
+one direction only (scenario <- collision <- loading).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from kcplan.world import scenario as scenario_format
+from kcplan.world.collision import CollisionWorld
+from kcplan.world.scenario import Scenario, ScenarioError
+
+__all__ = ["check_start_goal", "load_scenario", "parse_scenario"]
+
+
+def check_start_goal(scenario: Scenario) -> None:
+    """Raise :class:`ScenarioError` naming the obstacles the robot touches at the start or
+    the goal (``FILE: start: the robot collides with obstacles[3] (box)``)."""
+    world = CollisionWorld(scenario)
+    for key, pose in (("start", scenario.start), ("goal", scenario.goal)):
+        hits = world.colliding_obstacles(pose)
+        if hits:
+            labels = ", ".join(scenario.obstacles[i].label for i in hits[:3])
+            raise ScenarioError(f"{scenario.source}: {key}: the robot collides with {labels}")
+
+
+def parse_scenario(
+    data: Any, source: str = "<string>", directory: Path | None = None, check: bool = True
+) -> Scenario:
+    """:func:`kcplan.world.scenario.parse_scenario`, then (``check``)
+    :func:`check_start_goal`."""
+    scenario = scenario_format.parse_scenario(data, source, directory)
+    if check:
+        check_start_goal(scenario)
+    return scenario
+
+
+def load_scenario(path: str | os.PathLike, check: bool = True) -> Scenario:
+    """:func:`kcplan.world.scenario.load_scenario`, then (``check``)
+    :func:`check_start_goal`.
+
+    Raises
+    ------
+    ScenarioError
+        For every problem with the file (see :func:`kcplan.world.scenario.load_scenario`)
+        and, with ``check``, a start or goal in collision.
+    """
+    scenario = scenario_format.load_scenario(path)
+    if check:
+        check_start_goal(scenario)
+    return scenario
