@@ -156,18 +156,51 @@ def test_sweep_test_and_occupancy_reject_without_guards():
     assert world.counters == queries and certifier.counters["occupancy_rejections"] == 1
 
 
-@pytest.mark.parametrize("path", SUITE, ids=lambda p: Path(p).stem)
-@pytest.mark.parametrize("planner", ["kc-rrtconnect", "kc-prm"])
-def test_kc_planners_never_return_colliding_paths(path, planner):
+HARD = {
+    ("window_wall", "kc-rrtconnect"): (1, 30.0),
+    ("narrow_tunnel", "kc-rrtconnect"): (2, 20.0),
+    ("room-32-32-4", "kc-rrtconnect"): (1, 20.0),
+    ("room-32-32-4", "kc-prm"): (2, 40.0),
+}
+"""Hard passages: a seed that solves in a fresh process (where the seed fixes OMPL's
+sampling) within a few seconds, and a budget several times that."""
+SUITE_RUNS = [
+    (path, planner)
+    for path in SUITE
+    for planner in ("kc-rrtconnect", "kc-prm")
+    # kc-prm solves window_wall in 0 to 2 of 10 runs of 10 s (benchmarks/RESULTS.md):
+    # no budget a unit test can afford makes it a reliable check
+    if (Path(path).stem, planner) != ("window_wall", "kc-prm")
+]
+
+
+@pytest.mark.parametrize(
+    "path, planner", SUITE_RUNS, ids=lambda v: Path(v).stem if "/" in str(v) else v
+)
+def test_kc_planners_never_return_colliding_paths(path, planner, tmp_path):
+    """Every suite map is solved (a slower or broken planner fails here) and the path
+    verifies without gaps."""
     scenario = load_scenario(path)
-    result = plan(scenario, planner, time_limit=4.0, seed=1)
-    if not result.solved:
-        pytest.skip(f"{planner} did not solve {scenario.name} in 4 s (hard narrow passage)")
-    check = verify_path(CollisionWorld(scenario), result.states)
+    hard = HARD.get((Path(path).stem, planner))
+    if hard is None:
+        result = plan(scenario, planner, time_limit=8.0, seed=1)
+        assert result.solved, f"{planner} did not solve {scenario.name} in 8 s"
+        states = result.states
+    else:
+        seed, budget = hard
+        out = tmp_path / "path.json"
+        argv = ["plan", path, "--planner", planner, "--seed", str(seed), "--time", str(budget)]
+        proc = subprocess.run(
+            [sys.executable, "-m", "kcplan.cli", *argv, "-o", str(out)],
+            capture_output=True,
+            text=True,
+            timeout=3 * budget + 60,
+        )
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        states = json.loads(out.read_text())["states"]
+    check = verify_path(CollisionWorld(scenario), states)
     assert not check.collides, check
-    assert np.allclose(result.states[0], scenario.start) and np.allclose(
-        result.states[-1], scenario.goal
-    )
+    assert np.allclose(states[0], scenario.start) and np.allclose(states[-1], scenario.goal)
 
 
 @pytest.mark.parametrize("planner", [p for p in PLANNERS if not PLANNERS[p].kc])
