@@ -442,3 +442,21 @@ def test_progress_is_live_on_a_terminal_and_logged_otherwise():
         "[1/2] s prm #0 (seed 1): hung: no result after 80 s; worker killed",
         "[2/2] s prm #1 (seed 1): unsolved in 2.00 s, 7 FCL queries",
     ]
+
+
+def test_distribution_plot_of_a_scenario_nobody_solved(tmp_path):
+    """Found by the CLI fuzz test: a bench whose runs all fail drew a log axis of nothing."""
+    from kcplan.bench.plots import plot_distributions
+
+    records = [
+        {
+            "scenario_name": "s",
+            "planner": "rrtconnect",
+            "solved": False,
+            "time": 0.01,
+            "counters": {"fcl_queries": 3},
+        }
+    ]
+    out = tmp_path / "s.png"
+    plot_distributions(records, "s", out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -65,7 +65,10 @@ def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.Pa
         for i, values in enumerate(data, start=1):
             ax.plot(np.full(len(values), i), values, ".", color="k", ms=3, alpha=0.5)
         ax.set_xticks(range(1, len(names) + 1), names, fontsize=8, rotation=30, ha="right")
-        ax.set_yscale("log")
+        if any(np.isfinite(v).any() for v in data):  # log of nothing fails in matplotlib
+            ax.set_yscale("log")
+        else:
+            ax.text(0.5, 0.5, "no solved runs", ha="center", transform=ax.transAxes)
         ax.set_ylabel(label)
         ax.grid(axis="y", alpha=0.3)
     fig.suptitle(f"{scenario}: solved runs")
