@@ -17,6 +17,7 @@ from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.rotations import log_rotation
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.ladder import GuardLadder
+from kcplan.planning.names import CERTIFIABLE
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
@@ -318,3 +319,24 @@ def test_python_entry_point_plans_and_verifies():
     if not unsolved.solved:
         with pytest.raises(ValueError, match="expected a solved plan"):
             unsolved.verify()
+
+
+@pytest.mark.parametrize("name", CERTIFIABLE)
+def test_every_certifiable_ompl_planner_runs_with_the_kc_validator(name):
+    """``kc-<name>`` really calls the validator (its counters move) and returns a path that
+    verifies without gaps; asymptotically optimal planners run to the 2 s limit."""
+    scenario = load_scenario(ROOT / "scenarios" / "2d" / "random_clutter.yaml")
+    result = plan(scenario, f"kc-{name}", time_limit=2.0, seed=1)
+    assert result.counters["kc_edges"] > 0 and result.counters["kc_guards"] > 0
+    assert result.solved, f"kc-{name} did not solve random_clutter in 2 s"
+    assert not result.verify().collides
+
+
+@pytest.mark.parametrize("name", ["kc-kpiece1", "ca-bkpiece1", "kc-lbkpiece1"])
+def test_last_valid_planners_are_refused_with_the_reason(name):
+    scenario = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
+    with pytest.raises(ValueError, match="last valid state .* never passes"):
+        plan(scenario, name, time_limit=0.1)
+    assert (
+        main(["plan", str(ROOT / "scenarios" / "2d" / "open_field.yaml"), "--planner", name]) == 2
+    )

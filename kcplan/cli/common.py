@@ -13,6 +13,7 @@ __all__ = [
     "finite_float",
     "load_input",
     "output_file",
+    "planner_name",
     "positive_float",
     "positive_int",
 ]
@@ -81,3 +82,13 @@ def finite_float(text: str) -> float:
     if not np.isfinite(value):
         raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
     return value
+
+
+def planner_name(text: str) -> str:
+    """A planner name (``--planner``); refused planners get their reason."""
+    from kcplan.planning.names import check_planner_name
+
+    try:
+        return check_planner_name(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None

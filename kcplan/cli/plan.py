@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from kcplan.cli.common import load_input, output_file, positive_float
+from kcplan.cli.common import load_input, output_file, planner_name, positive_float
 
 
 def _print_counters(counters: dict) -> None:
@@ -86,8 +86,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--planner",
         default="kc-rrtconnect",
-        choices=PLANNER_NAMES,
-        help="planner (default kc-rrtconnect)",
+        type=planner_name,
+        metavar="PLANNER",
+        help=f"planner (default kc-rrtconnect): {', '.join(PLANNER_NAMES)}",
     )
     p.add_argument(
         "--time",

@@ -1,5 +1,23 @@
 """Planner names, importable without loading OMPL (for the command line's help)."""
 
+CERTIFIABLE = (
+    "rrt",
+    "rrtstar",
+    "informedrrtstar",
+    "sorrtstar",
+    "aorrtc",
+    "prmstar",
+    "fmt",
+    "bfmt",
+    "bitstar",
+)
+"""OMPL planners (besides RRT-Connect and PRM) that reach the motion validator only through
+the two-argument ``checkMotion``: each is offered stock, as ``kc-<name>`` and as
+``ca-<name>``. The asymptotically optimal ones run to the time limit."""
+
+LAST_VALID = ("kpiece1", "bkpiece1", "lbkpiece1")
+"""OMPL planners that ask the motion validator for the last valid state: offered stock only."""
+
 PLANNER_NAMES = (
     "kc-rrtconnect",
     "kc-prm",
@@ -12,7 +30,29 @@ PLANNER_NAMES = (
     "prm",
     "rrtconnect-fine",
     "prm-fine",
-    "rrt",
-    "rrtstar",
-    "bitstar",
+    *CERTIFIABLE,
+    *LAST_VALID,
+    *(f"kc-{name}" for name in CERTIFIABLE),
+    *(f"ca-{name}" for name in CERTIFIABLE),
 )
+
+REFUSED_PLANNERS = {
+    f"{kind}-{name}": (
+        f"{name.upper()} asks the motion validator for the last valid state of a rejected "
+        "edge (checkMotion with lastValid), which the OMPL Python binding never passes to "
+        "a Python validator, so a rejected edge would count as wholly invalid; use the "
+        f"stock {name} or another kc planner"
+    )
+    for kind in ("kc", "ca")
+    for name in LAST_VALID
+}
+"""Certified variants refused on purpose, with the reason given to the user."""
+
+
+def check_planner_name(name: str) -> str:
+    """``name`` if it is a planner; otherwise ``ValueError`` with one line saying why."""
+    if name in REFUSED_PLANNERS:
+        raise ValueError(f"{name}: refused: {REFUSED_PLANNERS[name]}")
+    if name not in PLANNER_NAMES:
+        raise ValueError(f"expected a planner name ({', '.join(PLANNER_NAMES)}), got {name!r}")
+    return name

@@ -7,6 +7,7 @@ differences are the planner and, for the ``kc-*`` planners, the motion validator
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -15,7 +16,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from kcplan.planning.certifier import CERTIFICATE_SETS
-from kcplan.planning.names import PLANNER_NAMES
+from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, check_planner_name
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
@@ -94,10 +95,32 @@ PLANNERS: dict[str, PlannerSpec] = {
         description="stock PRM, discrete validator at 0.1 % of the extent",
         resolution=0.001,
     ),
-    "rrt": PlannerSpec(og.RRT, description="stock RRT"),
-    "rrtstar": PlannerSpec(og.RRTstar, description="stock RRT* (runs to the time limit)"),
-    "bitstar": PlannerSpec(og.BITstar, description="stock BIT* (runs to the time limit)"),
 }
+_OMPL = {
+    "rrt": (og.RRT, "RRT"),
+    "rrtstar": (og.RRTstar, "RRT* (runs to the time limit)"),
+    "informedrrtstar": (og.InformedRRTstar, "Informed RRT* (runs to the time limit)"),
+    "sorrtstar": (og.SORRTstar, "SORRT* (runs to the time limit)"),
+    "aorrtc": (og.AORRTC, "AORRTC (runs to the time limit)"),
+    "prmstar": (og.PRMstar, "PRM* (runs to the time limit)"),
+    "fmt": (og.FMT, "FMT*"),
+    "bfmt": (og.BFMT, "bidirectional FMT*"),
+    "bitstar": (og.BITstar, "BIT* (runs to the time limit)"),
+    "kpiece1": (og.KPIECE1, "KPIECE1 (stock only: it needs lastValid)"),
+    "bkpiece1": (og.BKPIECE1, "BKPIECE1 (stock only: it needs lastValid)"),
+    "lbkpiece1": (og.LBKPIECE1, "LBKPIECE1 (stock only: it needs lastValid)"),
+}
+for _name, (_make, _what) in _OMPL.items():
+    PLANNERS[_name] = PlannerSpec(_make, description=f"stock {_what}")
+for _name in CERTIFIABLE:
+    _make, _what = _OMPL[_name]
+    PLANNERS[f"kc-{_name}"] = PlannerSpec(
+        _make, _KC, description=f"{_what}, edges certified like kc-rrtconnect"
+    )
+    PLANNERS[f"ca-{_name}"] = PlannerSpec(
+        _make, _CA, description=f"ablation: kc-{_name} with the clearance ball only"
+    )
+PLANNERS = {name: PLANNERS[name] for name in PLANNER_NAMES}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
 default discrete motion validator at the default resolution (1 % of the space extent).
 The ``kc-*``, ``ca-*`` and ``kc-*-paper`` planners differ only in their certificates."""
@@ -175,6 +198,7 @@ def plan(
     seed: int | None = None,
     simplify: bool = True,
     world: CollisionWorld | None = None,
+    first_solution: bool = False,
 ) -> PlanResult:
     """Plan a path for the scenario's robot from start to goal.
 
@@ -192,6 +216,10 @@ def plan(
         checked by the same motion validator, so kc planners keep their guarantee.
     world : CollisionWorld, optional
         Reuse a collision world (its counters are reset).
+    first_solution : bool
+        Stop at the first exact solution: the optimization objective's cost threshold is
+        set to infinity, so asymptotically optimal planners (RRT*, BIT*, ...) report their
+        time to a first solution instead of running to the time limit.
 
     Returns
     -------
@@ -200,8 +228,10 @@ def plan(
         checks and guards together), ``checker_calls``, and for kc planners the
         validator's counters.
     """
-    if planner not in PLANNERS:
-        raise ValueError(f"planner: expected one of {', '.join(PLANNERS)}, got {planner!r}")
+    try:
+        check_planner_name(planner)
+    except ValueError as err:
+        raise ValueError(f"planner: {err}") from None
     spec = PLANNERS[planner]
     if seed is not None:
         seed_ompl(seed)
@@ -240,6 +270,9 @@ def plan(
         planner_object.setRange(spec.range_factor * space.getMaximumExtent())
     if spec.neighbors is not None:
         planner_object.setMaxNearestNeighbors(spec.neighbors)
+    objective = ss.getProblemDefinition().getOptimizationObjective()
+    if first_solution and objective is not None:
+        objective.setCostThreshold(ob.Cost(math.inf))
 
     try:
         ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
