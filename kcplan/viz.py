@@ -29,6 +29,8 @@ __all__ = [
     "draw_scenario",
     "path_poses",
     "plot_path",
+    "body_shapes",
+    "scenario_axes",
 ]
 
 
@@ -120,7 +122,7 @@ def _box_faces(center, R, half) -> list[np.ndarray]:
     return [V[q] for q in quads]
 
 
-def _bodies(robot: Robot, pose, inflation: float = 0.0):
+def body_shapes(robot: Robot, pose, inflation: float = 0.0):
     """``(R, t, semi_axes)`` of every body of ``robot`` at ``pose``, each scaled by
     ``1 + inflation`` about its own centre."""
     n = robot.dimension
@@ -166,13 +168,13 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
                     )
                 )
         for pose in poses:
-            for R, t, a in _bodies(robot, pose):
+            for R, t, a in body_shapes(robot, pose):
                 ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
         for pose, color, label in (
             (scenario.start, "tab:green", "start"),
             (scenario.goal, "tab:red", "goal"),
         ):
-            for k, (R, t, a) in enumerate(_bodies(robot, pose)):
+            for k, (R, t, a) in enumerate(body_shapes(robot, pose)):
                 ax.add_patch(
                     Polygon(
                         _ellipse_outline(t, R, a),
@@ -215,11 +217,11 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             Poly3DCollection(faces, facecolors=colors, edgecolors="0.3", linewidths=0.2, alpha=0.35)
         )
     for pose in poses:
-        for R, t, a in _bodies(robot, pose):
+        for R, t, a in body_shapes(robot, pose):
             surface = _ellipsoid_surface(t, R, a, 8)
             ax.plot_wireframe(*surface, color="tab:blue", lw=0.3, alpha=0.5)
     for pose, color in ((scenario.start, "tab:green"), (scenario.goal, "tab:red")):
-        for R, t, a in _bodies(robot, pose):
+        for R, t, a in body_shapes(robot, pose):
             ax.plot_surface(*_ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
     corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
     for i in range(8):
@@ -235,7 +237,7 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
     ax.set_zlabel("z")
 
 
-def _scenario_axes(scenario: Scenario):
+def scenario_axes(scenario: Scenario):
     """A figure sized to the map: a 2D top view, or 3D axes."""
     if scenario.dimension == 2:
         low, high = scenario.bounds
@@ -255,7 +257,7 @@ def plot_scenario(
     guards: float | None = None,
 ) -> None:
     """Draw a scenario (2D top view or 3D perspective) into an image file."""
-    fig, ax = _scenario_axes(scenario)
+    fig, ax = scenario_axes(scenario)
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
     ax.set_title(title or "\n".join(textwrap.wrap(heading, 100)), fontsize=9)
@@ -285,13 +287,13 @@ def plot_path(
     if given, guards as ``(pose, inflation)`` pairs (dashed)."""
     n = scenario.dimension
     poses = path_poses(states, n) if len(states) else []
-    fig, ax = _scenario_axes(scenario)
+    fig, ax = scenario_axes(scenario)
     draw_scenario(ax, scenario, poses)
     if len(states):
         P = np.asarray(states)
         ax.plot(*P[:, :n].T, color="tab:blue", lw=1.2, marker="o", ms=3)
     for pose, eps in guards or []:
-        for R, t, a in _bodies(scenario.robot, pose, eps):
+        for R, t, a in body_shapes(scenario.robot, pose, eps):
             if n == 2:
                 ax.plot(*_ellipse_outline(t, R, a).T, color="tab:orange", ls="--", lw=0.6)
             else:

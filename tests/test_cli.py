@@ -103,3 +103,21 @@ def test_start_yaw_is_normalised_for_ompl(yaw, tmp_path, capsys):
     assert math.isclose(math.cos(scenario.start[2]), math.cos(yaw), abs_tol=1e-12)
     assert main(["plan", str(path), "--seed", "1", "--time", "2"]) == 0
     assert "solved by kc-rrtconnect" in capsys.readouterr().out
+
+
+def test_plan_animate_writes_a_small_gif_of_every_body(tmp_path, capsys):
+    from PIL import Image
+
+    root = Path(__file__).resolve().parents[1]
+    scenario = str(root / "scenarios" / "2d" / "l_robot_door.yaml")
+    out = tmp_path / "door.gif"
+    assert main(["plan", scenario, "--seed", "1", "--animate", str(out)]) == 0
+    assert "animation written to" in capsys.readouterr().out
+    assert out.read_bytes()[:6] == b"GIF89a" and out.stat().st_size < 5 * 2**20
+    with Image.open(out) as gif:
+        assert gif.n_frames >= 30
+    assert [p.name for p in tmp_path.iterdir()] == ["door.gif"]  # no temporary file left
+    # a wrong suffix or a missing folder is refused before any planning
+    assert main(["plan", scenario, "--animate", str(tmp_path / "door.png")]) == 2
+    assert main(["plan", scenario, "--animate", str(tmp_path / "no" / "d.gif")]) == 2
+    assert "--animate: expected a .gif file name" in capsys.readouterr().err

@@ -34,6 +34,7 @@ OPTIONS = {
         "--seed": numbers,
         "-o": "json",
         "--plot": "png",
+        "--animate": "gif",
         "--guards": None,
         "--no-simplify": None,
     },
@@ -99,7 +100,7 @@ def command_lines(draw, folder: Path) -> tuple[list[str], list[Path]]:
     def an_output(suffix: str) -> str:
         where = draw(st.sampled_from(["here", "nofolder", "wrongsuffix"]))
         base = folder / "out" if where == "here" else folder / "no" / "such"
-        name = {"png": "x.png", "json": "x.json", "dir": "results"}[suffix]
+        name = {"png": "x.png", "gif": "x.gif", "json": "x.json", "dir": "results"}[suffix]
         if where == "wrongsuffix" and suffix != "dir":
             name = "x.txt"
         path = base / name

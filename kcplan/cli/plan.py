@@ -24,9 +24,11 @@ def _print_counters(counters: dict) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Plan, print the result and counters, write ``-o`` and ``--plot``; exit 1 when not solved."""
+    """Plan, print the result and counters, write ``-o``, ``--plot`` and ``--animate``;
+    exit 1 when not solved."""
     output_file(args.output, "-o")
     output_file(args.plot, "--plot", (".png",))
+    output_file(args.animate, "--animate", (".gif",))
     scenario = load_input(args.scenario)
     from kcplan.planning.problem import plan
 
@@ -58,6 +60,13 @@ def run(args: argparse.Namespace) -> int:
             title=f"{scenario.name}: {args.planner}, {status}",
         )
         print(f"plot written to {args.plot}")
+    if args.animate and result.solved:
+        from kcplan.animation import animate_path
+
+        frames = animate_path(
+            scenario, result.states, args.animate, title=f"{scenario.name}: {args.planner}"
+        )
+        print(f"animation written to {args.animate} ({frames} frames)")
     return 0 if result.solved else 1
 
 
@@ -107,4 +116,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="PATH.json", help="write the path as JSON")
     p.add_argument("--plot", metavar="FILE.png", help="draw the map and the path")
     p.add_argument("--guards", action="store_true", help="also draw the guards certifying the path")
+    p.add_argument(
+        "--animate", metavar="FILE.gif", help="write a GIF of the robot moving along the path"
+    )
     p.set_defaults(handler=run)
