@@ -4,6 +4,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from kcplan.cli import main
@@ -121,3 +122,38 @@ def test_plan_animate_writes_a_small_gif_of_every_body(tmp_path, capsys):
     assert main(["plan", scenario, "--animate", str(tmp_path / "door.png")]) == 2
     assert main(["plan", scenario, "--animate", str(tmp_path / "no" / "d.gif")]) == 2
     assert "--animate: expected a .gif file name" in capsys.readouterr().err
+
+
+def test_html_view_renders_the_scene_in_a_headless_browser(tmp_path, capsys):
+    """`kcplan plan --html` writes one self-contained file; Chromium (headless) renders it
+    offline and the screenshot shows the scene, not a blank page."""
+    import os
+    import shutil
+
+    from PIL import Image
+
+    browser = shutil.which("chromium")
+    if browser is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI installs Debian's chromium for this test (.ci/run)")
+        pytest.skip("no chromium (apt-get install chromium)")
+    root = Path(__file__).resolve().parents[1]
+    page = tmp_path / "door.html"
+    scenario = str(root / "scenarios" / "2d" / "l_robot_door.yaml")
+    assert main(["plan", scenario, "--seed", "1", "--html", str(page)]) == 0
+    html = page.read_text()
+    assert "<script" in html and "cdn." not in html.split("<body>")[0].lower()  # embedded
+    shot = tmp_path / "shot.png"
+    subprocess.run(
+        [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+         "--window-size=1000,750", "--virtual-time-budget=8000", f"--screenshot={shot}",
+         page.as_uri()],
+        capture_output=True, timeout=120, check=True,
+    )  # fmt: skip
+    image = np.asarray(Image.open(shot).convert("RGB")).reshape(-1, 3)
+    grey = np.all(np.abs(image.astype(int) - [150, 150, 150]) < 20, axis=1).mean()
+    red = np.mean((image[:, 0] > 150) & (image[:, 1] < 90) & (image[:, 2] < 90))
+    blue = np.mean((image[:, 2] > 140) & (image[:, 0] < 80) & (image[:, 1] < 150))
+    # obstacles (grey), the goal (red) and the robot on its path (blue) are on the page
+    assert grey > 0.005 and red > 0.0002 and blue > 0.0002, (grey, red, blue)
+    assert main(["show", scenario, "--html", str(tmp_path / "x.txt")]) == 2

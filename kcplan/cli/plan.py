@@ -24,11 +24,13 @@ def _print_counters(counters: dict) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Plan, print the result and counters, write ``-o``, ``--plot`` and ``--animate``;
+    """Plan, print the result and counters, write ``-o``, ``--plot``, ``--animate`` and
+    ``--html``;
     exit 1 when not solved."""
     output_file(args.output, "-o")
     output_file(args.plot, "--plot", (".png",))
     output_file(args.animate, "--animate", (".gif",))
+    output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
     from kcplan.planning.problem import plan
 
@@ -67,6 +69,11 @@ def run(args: argparse.Namespace) -> int:
             scenario, result.states, args.animate, title=f"{scenario.name}: {args.planner}"
         )
         print(f"animation written to {args.animate} ({frames} frames)")
+    if args.html:
+        from kcplan.html_view import write_scene_html
+
+        write_scene_html(scenario, args.html, result.states if result.solved else None)
+        print(f"interactive view written to {args.html}")
     return 0 if result.solved else 1
 
 
@@ -118,5 +125,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--guards", action="store_true", help="also draw the guards certifying the path")
     p.add_argument(
         "--animate", metavar="FILE.gif", help="write a GIF of the robot moving along the path"
+    )
+    p.add_argument(
+        "--html",
+        metavar="FILE.html",
+        help="write an interactive 3D view (one self-contained HTML file, works offline)",
     )
     p.set_defaults(handler=run)

@@ -9,9 +9,17 @@ from kcplan.cli.common import load_input, output_file
 
 
 def run(args: argparse.Namespace) -> int:
-    """Draw the scenario into ``-o`` (default beside it)."""
+    """Draw the scenario into ``-o`` (default beside it) and ``--html``."""
     output_file(args.output, "-o", (".png",))
+    output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
+    if args.html:
+        from kcplan.html_view import write_scene_html
+
+        write_scene_html(scenario, args.html)
+        print(f"interactive view written to {args.html}")
+        if not args.output:
+            return 0
     out = args.output or str(Path(args.scenario).with_suffix(".png"))
     from kcplan.viz import plot_scenario
 
@@ -33,6 +41,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "-o",
         "--output",
         metavar="FILE.png",
-        help="image file (default: beside the scenario, same name, .png)",
+        help="image file (default: beside the scenario, same name, .png; not with --html)",
     )
+    p.add_argument("--html", metavar="FILE.html", help="write an interactive 3D view instead")
     p.set_defaults(handler=run)
