@@ -246,6 +246,18 @@ class _Reader:
             self.fail(where, f"{n} {kind}" + self._range_note(xs, positive), value)
         return np.array(xs, dtype=float)
 
+    def points(self, value: Any, where: str, n: int, least: int, most: int) -> NDArray:
+        """A list of ``least`` to ``most`` points of ``n`` coordinates, shape ``(k, n)``."""
+        if not isinstance(value, list) or not least <= len(value) <= most:
+            coordinates = "[x, y]" if n == 2 else "[x, y, z]"
+            self.fail(
+                where,
+                f"a list of {least} to {most} points {coordinates}",
+                value,
+                f"{len(value)} points" if isinstance(value, list) else None,
+            )
+        return np.array([self.vector(v, f"{where}[{i}]", n) for i, v in enumerate(value)])
+
     def text(self, value: Any, where: str) -> str:
         if not isinstance(value, str) or not value.strip():
             self.fail(where, "a non-empty string", value)
@@ -344,15 +356,7 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
         return Obstacle(kind, index, spec, center, eye, np.full(n, radius))
     if kind == "polygon":
         spec = r.mapping(spec, where, ("vertices",))
-        vertices = spec["vertices"]
-        if not isinstance(vertices, list) or not 3 <= len(vertices) <= MAX_POLYGON_VERTICES:
-            r.fail(
-                f"{where}.vertices",
-                f"a list of 3 to {MAX_POLYGON_VERTICES} points [x, y]",
-                vertices,
-                f"{len(vertices)} points" if isinstance(vertices, list) else None,
-            )
-        pts = np.array([r.vector(v, f"{where}.vertices[{i}]", 2) for i, v in enumerate(vertices)])
+        pts = r.points(spec["vertices"], f"{where}.vertices", 2, 3, MAX_POLYGON_VERTICES)
         try:
             pieces = tuple(convex_pieces(pts))
         except ValueError as err:
@@ -360,15 +364,7 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
         return Obstacle(kind, index, spec, pts.mean(axis=0), eye, zeros, pieces)
     if kind == "convex":
         spec = r.mapping(spec, where, ("vertices",), ("position", "quaternion"))
-        points = spec["vertices"]
-        if not isinstance(points, list) or not 4 <= len(points) <= MAX_CONVEX_VERTICES:
-            r.fail(
-                f"{where}.vertices",
-                f"a list of 4 to {MAX_CONVEX_VERTICES} points [x, y, z]",
-                points,
-                f"{len(points)} points" if isinstance(points, list) else None,
-            )
-        local = np.array([r.vector(v, f"{where}.vertices[{i}]", 3) for i, v in enumerate(points)])
+        local = r.points(spec["vertices"], f"{where}.vertices", 3, 4, MAX_CONVEX_VERTICES)
         position = r.vector(spec.get("position", [0.0, 0.0, 0.0]), f"{where}.position", 3)
         R = r.rotation(spec, where, 3)
         try:
