@@ -25,7 +25,8 @@ from kcplan.world.support import box_vertices
 __all__ = ["scene_figure", "write_scene_html"]
 
 _SPHERE = convex_hull(unit_normals(3, 160))  # unit sphere: vertices and triangles
-_CIRCLE = np.column_stack([np.cos(t := np.linspace(0, 2 * np.pi, 48, endpoint=False)), np.sin(t)])
+_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+_CIRCLE = np.column_stack([np.cos(_ANGLES), np.sin(_ANGLES)])  # unit circle, 48 points
 
 
 def _flat(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
