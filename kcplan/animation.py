@@ -4,23 +4,20 @@ from __future__ import annotations
 
 import os
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
-
-from kcplan.files import atomic_output  # noqa: E402
-from kcplan.viz import (  # noqa: E402
-    _ellipse_outline,
-    _ellipsoid_surface,
+from kcplan.files import atomic_output
+from kcplan.viz import (  # viz selects matplotlib's non-interactive backend
     body_shapes,
     draw_scenario,
+    ellipse_outline,
+    ellipsoid_surface,
     path_poses,
     scenario_axes,
 )
-from kcplan.world.scenario import Scenario  # noqa: E402
+from kcplan.world.scenario import Scenario
 
 __all__ = ["animate_path"]
 
@@ -68,9 +65,9 @@ def animate_path(
         moving.clear()
         for R, t, a in body_shapes(scenario.robot, poses[i]):
             if n == 2:
-                moving.extend(ax.fill(*_ellipse_outline(t, R, a).T, color="tab:blue", alpha=0.8))
+                moving.extend(ax.fill(*ellipse_outline(t, R, a).T, color="tab:blue", alpha=0.8))
             else:
-                surface = _ellipsoid_surface(t, R, a, 10)
+                surface = ellipsoid_surface(t, R, a, 10)
                 moving.append(ax.plot_surface(*surface, color="tab:blue", alpha=0.9, lw=0))
         return moving
 

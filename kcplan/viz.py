@@ -30,6 +30,8 @@ __all__ = [
     "path_poses",
     "plot_path",
     "body_shapes",
+    "ellipse_outline",
+    "ellipsoid_surface",
     "scenario_axes",
 ]
 
@@ -92,12 +94,14 @@ def plot_convex_bound(bound: ConvexLowerBound, path: str | os.PathLike) -> None:
 _OBSTACLE_STYLE = {"facecolor": "0.55", "edgecolor": "0.25", "linewidth": 0.6}
 
 
-def _ellipse_outline(center, R, axes, k: int = 72) -> np.ndarray:
+def ellipse_outline(center, R, axes, k: int = 72) -> np.ndarray:
+    """``k`` points ``(k, 2)`` on the ellipse with centre, rotation ``R`` and semi-axes."""
     t = np.linspace(0.0, 2.0 * np.pi, k)
     return center + (np.column_stack([np.cos(t), np.sin(t)]) * axes) @ R.T
 
 
-def _ellipsoid_surface(center, R, axes, k: int = 16):
+def ellipsoid_surface(center, R, axes, k: int = 16):
+    """Grid ``(X, Y, Z)``, each ``(k, 2k)``, of the ellipsoid's surface (for plot_surface)."""
     u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 2 * k), np.linspace(0, np.pi, k))
     unit = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)], axis=-1)
     pts = center + (unit * axes) @ R.T
@@ -162,14 +166,14 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             else:
                 ax.add_patch(
                     Polygon(
-                        _ellipse_outline(ob.center, ob.rotation, ob.extents),
+                        ellipse_outline(ob.center, ob.rotation, ob.extents),
                         closed=True,
                         **_OBSTACLE_STYLE,
                     )
                 )
         for pose in poses:
             for R, t, a in body_shapes(robot, pose):
-                ax.plot(*_ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
+                ax.plot(*ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
         for pose, color, label in (
             (scenario.start, "tab:green", "start"),
             (scenario.goal, "tab:red", "goal"),
@@ -177,7 +181,7 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             for k, (R, t, a) in enumerate(body_shapes(robot, pose)):
                 ax.add_patch(
                     Polygon(
-                        _ellipse_outline(t, R, a),
+                        ellipse_outline(t, R, a),
                         closed=True,
                         fc=color,
                         alpha=0.5,
@@ -186,7 +190,7 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
                     )
                 )
                 if guards:
-                    outline = _ellipse_outline(t, R, (1 + guards) * a)
+                    outline = ellipse_outline(t, R, (1 + guards) * a)
                     ax.plot(*outline.T, color=color, ls=":", lw=0.8)
             R, t = pose_frame(pose, 2)  # the robot's heading, from its origin
             ax.plot(*np.array([t, t + R[:, 0] * robot.reach]).T, color="k", lw=0.8)
@@ -207,7 +211,7 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             colors += ["tab:brown"] * len(ob.triangles)
         else:
             ax.plot_surface(
-                *_ellipsoid_surface(ob.center, ob.rotation, ob.extents),
+                *ellipsoid_surface(ob.center, ob.rotation, ob.extents),
                 color="0.6",
                 alpha=0.5,
                 linewidth=0,
@@ -218,11 +222,11 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
         )
     for pose in poses:
         for R, t, a in body_shapes(robot, pose):
-            surface = _ellipsoid_surface(t, R, a, 8)
+            surface = ellipsoid_surface(t, R, a, 8)
             ax.plot_wireframe(*surface, color="tab:blue", lw=0.3, alpha=0.5)
     for pose, color in ((scenario.start, "tab:green"), (scenario.goal, "tab:red")):
         for R, t, a in body_shapes(robot, pose):
-            ax.plot_surface(*_ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
+            ax.plot_surface(*ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
     corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
     for i in range(8):
         for j in range(i + 1, 8):
@@ -295,9 +299,9 @@ def plot_path(
     for pose, eps in guards or []:
         for R, t, a in body_shapes(scenario.robot, pose, eps):
             if n == 2:
-                ax.plot(*_ellipse_outline(t, R, a).T, color="tab:orange", ls="--", lw=0.6)
+                ax.plot(*ellipse_outline(t, R, a).T, color="tab:orange", ls="--", lw=0.6)
             else:
-                surface = _ellipsoid_surface(t, R, a, 6)
+                surface = ellipsoid_surface(t, R, a, 6)
                 ax.plot_wireframe(*surface, color="tab:orange", lw=0.3, alpha=0.5)
     extra = f", {len(guards)} guards (dashed)" if guards else ""
     ax.set_title((title or scenario.name) + extra, fontsize=9)

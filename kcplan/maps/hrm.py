@@ -232,28 +232,15 @@ def _robot(path: Path, name: str, n: int) -> tuple[dict, str, float]:
                 f"exponents 1), got {row.tolist()}"
             )
         if n == 2:
-            body = {"semi_axes": _round(axes), "position": _round(row[3:5]), "yaw": float(row[5])}
+            pose = [*row[3:5], row[5]]
         else:
-            body = {
-                "semi_axes": _round(axes),
-                "position": _round(row[5:8]),
-                "quaternion": _round(_axis_angle_quaternion(row[8:11], row[11])),
-            }
-        bodies.append(body)
-    spec = {"bodies": bodies}
-    robot = Robot(
-        [
-            Body(np.array(b["semi_axes"]), np.array([*b["position"], b["yaw"]]))
-            if n == 2
-            else Body(np.array(b["semi_axes"]), np.array(b["position"] + b["quaternion"]))
-            for b in bodies
-        ]
-    )
-    if robot.is_single:
-        spec = {"semi_axes": bodies[0]["semi_axes"]}
+            pose = [*row[5:8], *_axis_angle_quaternion(row[8:11], row[11])]
+        bodies.append(Body(np.array(_round(axes)), np.array(_round(pose))))
+    robot = Robot(bodies)
     shape = "ellipse" if n == 2 else "ellipsoid"
-    sizes = "; ".join(" x ".join(f"{v:g}" for v in b["semi_axes"]) for b in bodies)
+    sizes = "; ".join(" x ".join(f"{v:g}" for v in b.semi_axes) for b in bodies)
     text = f"Robot: HRM's {name}, {len(bodies)} {shape}{'s' * (len(bodies) > 1)} ({sizes})."
+    spec = robot.to_spec()
     return spec, text, robot.reach
 
 

@@ -165,7 +165,11 @@ class EdgeCertifier:
                 f"certificates: expected names from {', '.join(CERTIFICATE_NAMES)}, "
                 f"got {list(certificates)}"
             )
-        if not hasattr(world, "safe_body_clearances") and len(robot) > 1:
+        if hasattr(world, "safe_body_clearances"):
+            self._body_clearances = world.safe_body_clearances
+        elif len(robot) == 1:  # a one-body world may offer safe_clearance alone
+            self._body_clearances = lambda pose: (world.safe_clearance(pose),)
+        else:
             raise ValueError(
                 f"world: a robot of {len(robot)} bodies needs safe_body_clearances(pose)"
             )
@@ -214,13 +218,6 @@ class EdgeCertifier:
             # every body inflated by this factor about its centre is free
             self.guard_log.append((pose, guard.clearance / self.robot.largest_semi_axis))
         return guard
-
-    def _body_clearances(self, pose: np.ndarray):
-        """Per-body clearances; a one-body world may offer ``safe_clearance`` alone."""
-        world = self.world
-        if hasattr(world, "safe_body_clearances"):
-            return world.safe_body_clearances(pose)
-        return (world.safe_clearance(pose),)
 
     def state_valid(self, pose: ArrayLike, key: bytes | None = None) -> bool:
         """State validity with the cache: one collision query for a pose not seen before,

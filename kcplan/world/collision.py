@@ -129,10 +129,7 @@ class CollisionWorld:
         ]
         self._bodies = [fcl.CollisionObject(g, fcl.Transform()) for g in self._geometries]
         # body poses in the robot frame as plain floats: (x, y, z), quaternion [x, y, z, w]
-        self._offsets = [
-            (*(float(v) for v in b.position), 0.0)[:3] if n == 2 else tuple(b.position.tolist())
-            for b in robot.bodies
-        ]
+        self._offsets = [tuple(b.position.tolist()) + (0.0,) * (3 - n) for b in robot.bodies]
         self._turns = [
             (0.0, 0.0, math.sin(0.5 * b.pose[2]), math.cos(0.5 * b.pose[2]))
             if n == 2
