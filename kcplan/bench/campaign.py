@@ -60,7 +60,8 @@ class RunSpec:
 
     ``scenario`` is the scenario file (an absolute path, so that any worker can read it),
     ``run`` the index among the runs of this scenario and planner, ``time_limit`` the
-    seconds given to ``solve()`` (simplification gets the same again).
+    seconds given to ``solve()`` (simplification gets the same again), ``progress`` the
+    seconds between best-cost samples of anytime planners (None: none recorded).
     """
 
     scenario: str
@@ -70,6 +71,7 @@ class RunSpec:
     seed: int
     time_limit: float
     simplify: bool = True
+    progress: float | None = None
 
     @property
     def key(self) -> tuple[str, str, int]:
@@ -83,6 +85,7 @@ def campaign_specs(
     seed: int,
     time_limit: float,
     simplify: bool = True,
+    progress: float | None = None,
 ) -> list[RunSpec]:
     """All runs of a campaign, twins next to each other.
 
@@ -91,7 +94,9 @@ def campaign_specs(
     the runs are ordered scenario, run, planner, so twins run at the same moment.
     """
     return [
-        RunSpec(str(Path(file).resolve()), name, planner, i, seed + i, time_limit, simplify)
+        RunSpec(
+            str(Path(file).resolve()), name, planner, i, seed + i, time_limit, simplify, progress
+        )
         for file, name in scenarios
         for i in range(runs)
         for planner in planners
@@ -358,7 +363,10 @@ def describe_run(record: dict) -> str:
     if not record["solved"]:
         return f"{head}: unsolved in {record['time']:.2f} s, {queries} FCL queries"
     path = "PATH COLLIDES" if record["collides"] else "path clean"
-    return f"{head}: solved in {record['time']:.3f} s, {queries} FCL queries, {path}"
+    found = f"solved in {record['time']:.3f} s"
+    if record.get("first_solution_time") is not None:
+        found = f"first solution at {record['first_solution_time']:.3f} s"
+    return f"{head}: {found}, {queries} FCL queries, {path}"
 
 
 def read_records(path: str | os.PathLike) -> list[dict]:

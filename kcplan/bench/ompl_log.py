@@ -24,6 +24,7 @@ from collections.abc import Callable, Sequence
 from datetime import datetime
 from pathlib import Path
 
+from kcplan.bench.summary import solution_time
 from kcplan.files import atomic_output
 
 __all__ = ["RUN_PROPERTIES", "STATUS", "format_log", "build_database"]
@@ -58,6 +59,7 @@ def _solved_value(name: str) -> Callable[[dict], object]:
 RUN_PROPERTIES: tuple[tuple[str, str, Callable[[dict], object]], ...] = (
     # OMPL's own names, so Planner Arena's default plots work
     ("time", "REAL", lambda r: r["time"]),
+    ("time to first solution", "REAL", lambda r: solution_time(r)),
     ("solved", "BOOLEAN", lambda r: r["solved"]),
     ("status", "ENUM", _status),
     ("approximate solution", "BOOLEAN", lambda r: False if r["status"] == "ok" else None),
@@ -187,8 +189,23 @@ def format_log(
         lines.append(f"{len(runs)} runs")
         for r in runs:
             lines.append("".join(f"{_value(get(r))}; " for _, _, get in RUN_PROPERTIES))
+        lines += _progress_lines(runs)
         lines.append(".")
     return "\n".join(lines) + "\n"
+
+
+def _progress_lines(runs: Sequence[dict]) -> list[str]:
+    """The planner's progress section (OMPL's format: property names, then one line per
+    run of ``value,...,;`` samples), or nothing when no run recorded progress."""
+    names = next((list(r["progress"]) for r in runs if r.get("progress")), [])
+    if not names:
+        return []
+    lines = [f"{len(names)} progress properties for each run", *names, f"{len(runs)} runs"]
+    for r in runs:
+        columns = [(r.get("progress") or {}).get(name, []) for name in names]
+        samples = zip(*columns, strict=True)
+        lines.append("".join("".join(f"{_value(v)}," for v in s) + ";" for s in samples))
+    return lines
 
 
 def build_database(logs: Sequence[str | os.PathLike], database: str | os.PathLike) -> None:

@@ -8,9 +8,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from kcplan.bench.summary import cost_at, solution_time
 from kcplan.viz import plt, save_figure  # pyplot with the Agg backend kcplan.viz chose
 
-__all__ = ["plot_distributions", "plot_success_vs_budget"]
+__all__ = ["plot_distributions", "plot_success_vs_budget", "plot_cost_over_time"]
 
 _COLORS = {
     "kc-rrtconnect": "#1f77b4",
@@ -28,8 +29,8 @@ _COLORS = {
 
 
 def _color(planner: str, i: int) -> str:
-    # planners without a colour of their own: grey shades
-    return _COLORS.get(planner, plt.cm.Greys(0.4 + 0.15 * (i % 4)))
+    # planners without a colour of their own: matplotlib's qualitative cycle
+    return _COLORS.get(planner, plt.cm.tab10(i % 10))
 
 
 def _planners(records: Sequence[dict]) -> list[str]:
@@ -46,7 +47,7 @@ def plot_distributions(records: Sequence[dict], scenario: str, path: str | os.Pa
     for ax, (label, get) in zip(
         axes,
         (
-            ("time to solution [s]", lambda r: r["time"]),
+            ("time to first solution [s]", solution_time),
             ("FCL queries (collision, distance, region)", lambda r: r["counters"]["fcl_queries"]),
         ),
         strict=True,
@@ -80,16 +81,14 @@ def plot_success_vs_budget(records: Sequence[dict], path: str | os.PathLike) -> 
     """Fraction of runs solved within each time budget, one panel per scenario; a
     returned path that collides counts as a failure."""
     scenarios = list(dict.fromkeys(r["scenario_name"] for r in records))
-    cols = min(4, len(scenarios))
-    rows = math.ceil(len(scenarios) / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.0 * rows), squeeze=False)
+    fig, axes = _panels(len(scenarios))
     limit = max(r["time_limit"] for r in records)
     budgets = np.geomspace(1e-3, limit, 200)
     for ax, scenario in zip(axes.flat, scenarios, strict=False):
         runs = [r for r in records if r["scenario_name"] == scenario]
         for i, planner in enumerate(_planners(runs)):
             mine = [r for r in runs if r["planner"] == planner]
-            times = np.array([r["time"] for r in mine if r["solved"] and not r["collides"]])
+            times = np.array([solution_time(r) for r in mine if r["solved"] and not r["collides"]])
             rate = (times[None, :] <= budgets[:, None]).sum(axis=1) / len(mine)
             ax.step(budgets, rate, where="post", label=planner, color=_color(planner, i))
         ax.set_xscale("log")
@@ -98,9 +97,56 @@ def plot_success_vs_budget(records: Sequence[dict], path: str | os.PathLike) -> 
         ax.set_xlabel("time budget [s]")
         ax.set_ylabel("success rate")
         ax.grid(alpha=0.3)
-    for ax in list(axes.flat)[len(scenarios) :]:
-        ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)
     fig.tight_layout(rect=(0, 0.06, 1, 1))
+    save_figure(fig, path)
+
+
+def _panels(n: int, width: float = 3.6, height: float = 3.0):
+    cols = min(4, n)
+    rows = math.ceil(n / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(width * cols, height * rows), squeeze=False)
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    return fig, axes
+
+
+def plot_cost_over_time(records: Sequence[dict], path: str | os.PathLike) -> None:
+    """Best cost against time of the planners that record progress, one panel per
+    scenario: the median over all runs (drawn once more than half the runs have a
+    solution) and the band between the 25th and 75th percentiles."""
+    runs = [r for r in records if r.get("progress")]
+    scenarios = list(dict.fromkeys(r["scenario_name"] for r in runs))
+    fig, axes = _panels(len(scenarios), 4.2, 3.2)
+    for ax, scenario in zip(axes.flat, scenarios, strict=False):
+        mine = [r for r in records if r["scenario_name"] == scenario]
+        limit = max(r["time_limit"] for r in mine)
+        grid = np.linspace(0.0, limit, 300)
+        for i, planner in enumerate(_planners(runs)):
+            theirs = [r for r in mine if r["planner"] == planner]
+            if not any(r.get("progress") for r in theirs):
+                continue
+            cost = np.array([[cost_at(r, t) for t in grid] for r in theirs])
+            with np.errstate(invalid="ignore"):  # inf - inf between unsolved runs
+                low, mid, high = np.percentile(cost, [25, 50, 75], axis=0)
+            color = _color(planner, i)
+            stock = not planner.startswith(("kc-", "ca-"))
+            ax.step(grid, mid, "--" if stock else "-", where="post", color=color, label=planner)
+            ax.fill_between(
+                grid,
+                low,
+                np.where(np.isfinite(high), high, np.nan),
+                step="post",
+                color=color,
+                alpha=0.2,
+                lw=0,
+            )
+        ax.set_title(scenario, fontsize=10)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("best cost (path length)")
+        ax.grid(alpha=0.3)
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     save_figure(fig, path)

@@ -10,6 +10,7 @@ Layout of ``DIR``::
     summary.md           the same as a table, with kc / stock-twin ratios
     plots/SCENARIO.png   time and FCL-query distributions per planner
     plots/success_vs_budget.png
+    plots/cost_over_time.png   best cost against time (when anytime planners ran)
 
 Reports are rebuilt from ``runs.jsonl`` by :func:`write_reports`, each file atomically,
 so an interrupted campaign still leaves complete files for the runs that finished.
@@ -24,7 +25,7 @@ from datetime import datetime
 from pathlib import Path
 
 from kcplan.bench.ompl_log import build_database, format_log
-from kcplan.bench.plots import plot_distributions, plot_success_vs_budget
+from kcplan.bench.plots import plot_cost_over_time, plot_distributions, plot_success_vs_budget
 from kcplan.bench.summary import summarize, summary_csv, summary_markdown
 from kcplan.files import write_text_atomic
 
@@ -126,6 +127,9 @@ def write_reports(
     written["summary.csv"], written["summary.md"] = out / "summary.csv", out / "summary.md"
     plot_success_vs_budget(records, out / "plots" / "success_vs_budget.png")
     written["plot:success"] = out / "plots" / "success_vs_budget.png"
+    if any(r.get("progress") for r in records):
+        plot_cost_over_time(records, out / "plots" / "cost_over_time.png")
+        written["plot:cost"] = out / "plots" / "cost_over_time.png"
     return written
 
 

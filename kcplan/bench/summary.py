@@ -1,7 +1,9 @@
 """Per scenario and planner statistics of a campaign: ``summary.csv`` and ``summary.md``.
 
-Conventions: times are seconds of ``solve()``; a run that did not solve (or whose worker
-failed) counts at the time limit in ``median_time`` and ``p90_time``, so a planner cannot
+Conventions: times are seconds of ``solve()`` to the first solution (anytime planners
+such as RRT* run on to the time limit; their first solution is found from their progress
+samples, :func:`solution_time`); a run that did not solve (or whose worker failed) counts
+at the time limit in ``median_time`` and ``p90_time``, so a planner cannot
 look fast by failing; ``median_fcl_queries`` (collision plus distance queries, state checks
 and guards together) is over runs whose worker finished; ``median_length`` is over solved
 runs (OMPL path length after simplification). A kc planner's *twin* is the stock planner
@@ -10,6 +12,9 @@ only that ran; its *ca twin* is the same planner with the plain clearance-ball
 certificate (``kc-prm`` -> ``ca-prm``, the ablation baseline). Ratios are twin / kc, so
 above 1 means kc wins. ``share_*`` columns are the share of the certified edge parameter
 each certificate won (from the ``kc_covered_*`` counters; medians over runs).
+``median_cost_10pct``, ``median_cost_50pct`` and ``median_cost_final`` are the median best
+cost at 10 %, 50 % and 100 % of the time limit over all runs, of planners that record
+progress (inf when more than half the runs have no solution yet; empty without progress).
 """
 
 from __future__ import annotations
@@ -25,6 +30,8 @@ from kcplan.planning.names import PLANNER_NAMES
 
 __all__ = [
     "SUMMARY_COLUMNS",
+    "solution_time",
+    "cost_at",
     "twin_of",
     "ca_twin_of",
     "summarize",
@@ -46,6 +53,9 @@ SUMMARY_COLUMNS = (
 )
 """The first columns of ``summary.csv``, in this order (issue 5)."""
 
+COST_FRACTIONS = {"median_cost_10pct": 0.1, "median_cost_50pct": 0.5, "median_cost_final": 1.0}
+COST_COLUMNS = tuple(COST_FRACTIONS)
+
 EXTRA_COLUMNS = (
     "failed_runs",
     "median_collision_queries",
@@ -62,6 +72,7 @@ EXTRA_COLUMNS = (
     "share_region",
     "share_polytope",
     "share_ball",
+    *COST_COLUMNS,
 )
 
 
@@ -84,6 +95,25 @@ def ca_twin_of(planner: str) -> str | None:
     return twin if twin in PLANNER_NAMES else None
 
 
+def solution_time(record: dict) -> float | None:
+    """Seconds to the first solution of a run: the recorded first-solution time of an
+    anytime planner (which runs to the time limit), else the solve time; None unsolved."""
+    if not record.get("solved"):
+        return None
+    first = record.get("first_solution_time")
+    return record["time"] if first is None else first
+
+
+def cost_at(record: dict, t: float) -> float:
+    """A run's best cost at ``t`` seconds into ``solve()`` from its progress samples
+    (the last sample at or before ``t``; inf before the first solution or without
+    samples)."""
+    progress = record.get("progress") or {}
+    times = progress.get("time REAL", [])
+    i = int(np.searchsorted(times, t, side="right")) - 1
+    return float(progress["best cost REAL"][i]) if i >= 0 else math.inf
+
+
 def _median(values: Sequence[float]) -> float:
     return float(np.median(values)) if len(values) else math.nan
 
@@ -97,7 +127,7 @@ def summarize(records: Sequence[dict]) -> list[dict]:
     for (scenario, planner), runs in groups.items():
         finished = [r for r in runs if r["status"] == "ok"]
         solved = [r for r in finished if r["solved"]]
-        charged = [r["time"] if r["solved"] else r["time_limit"] for r in runs]
+        charged = [r["time_limit"] if solution_time(r) is None else solution_time(r) for r in runs]
 
         def counter(name: str, runs=finished) -> float:
             return _median([r["counters"][name] for r in runs if name in r["counters"]])
@@ -128,6 +158,7 @@ def summarize(records: Sequence[dict]) -> list[dict]:
                 "twin": twin_of(planner) or "",
                 "ca_twin": ca_twin_of(planner) or "",
                 **_shares(finished),
+                **_costs(runs),
             }
         )
     by_key = {(r["scenario"], r["planner"]): r for r in rows}
@@ -156,6 +187,17 @@ def _shares(runs: Sequence[dict]) -> dict:
                 shares.append(covered.get(f"kc_covered_{name}", 0.0) / total)
         out[f"share_{name}"] = _median(shares)
     return out
+
+
+def _costs(runs: Sequence[dict]) -> dict:
+    """Median best cost at fractions of the time limit (NaN when no run has progress)."""
+    if not any(r.get("progress") for r in runs):
+        return dict.fromkeys(COST_COLUMNS, math.nan)
+    limit = runs[0]["time_limit"]
+    return {
+        column: _median([cost_at(r, f * limit) for r in runs])
+        for column, f in COST_FRACTIONS.items()
+    }
 
 
 def _ratio(twin: dict | None, row: dict, column: str) -> float:
@@ -214,4 +256,22 @@ def summary_markdown(rows: Sequence[dict], title: str = "Benchmark summary") -> 
             f"| {_fmt(r['ca_time_ratio'], '.2f')} | {_fmt(r['ca_query_ratio'], '.2f')} "
             f"| {_fmt(r['share_region'], '.2f')} | {_fmt(r['share_polytope'], '.2f')} |"
         )
+    anytime = [r for r in rows if not math.isnan(r["median_cost_final"])]
+    if anytime:
+        out += [
+            "",
+            "Best cost over time (anytime planners; OMPL's progress property *best cost*, "
+            "path length unless the objective says otherwise): median over all runs at 10 %, "
+            "50 % and 100 % of the time limit, inf while more than half the runs have no "
+            "solution; first solution as median time above.",
+            "",
+            "| scenario | planner | first solution | cost at 10 % | cost at 50 % | final cost |",
+            "|---|---|---|---|---|---|",
+        ]
+        out += [
+            f"| {r['scenario']} | {r['planner']} | {_fmt(r['median_time'], '.3f')} "
+            + "".join(f"| {_fmt(r[c], '.2f')} " for c in COST_COLUMNS)
+            + "|"
+            for r in anytime
+        ]
     return "\n".join(out) + "\n"

@@ -23,10 +23,13 @@ def execute(spec: dict) -> dict:
 
     The record holds ``status`` ("ok"), ``solved``, ``time`` (seconds in ``solve()``),
     ``simplify_time``, ``length`` and ``raw_length`` (OMPL path lengths after and before
-    simplification), ``states`` (the returned path), ``counters`` (FCL queries and, for kc
-    planners, the validator's counters), ``collides`` / ``min_clearance`` /
-    ``verify_queries`` (gap-free verification; None when unsolved), ``memory_mb`` (peak
-    resident set of the worker) and ``wall`` (seconds of the whole run).
+    simplification), ``states`` (the returned path), ``first_solution_time`` and
+    ``progress`` (best cost over time of anytime planners, see
+    :class:`kcplan.planning.progress.ProgressRecorder`; None and empty otherwise),
+    ``counters`` (FCL queries and, for kc planners, the validator's counters),
+    ``collides`` / ``min_clearance`` / ``verify_queries`` (gap-free verification; None
+    when unsolved), ``memory_mb`` (peak resident set of the worker) and ``wall`` (seconds
+    of the whole run).
     """
     t0 = time.perf_counter()
     from kcplan.planning.problem import plan
@@ -42,6 +45,7 @@ def execute(spec: dict) -> dict:
         seed=int(spec["seed"]),
         simplify=bool(spec.get("simplify", True)),
         world=world,
+        progress=spec.get("progress"),
     )
     check = verify_path(world, result.states) if result.solved else None
     return {
@@ -54,6 +58,8 @@ def execute(spec: dict) -> dict:
         "raw_length": result.raw_length if result.solved else None,
         "states": result.states,
         "counters": result.counters,
+        "first_solution_time": result.first_solution_time,
+        "progress": result.progress,
         "collides": None if check is None else check.collides,
         "min_clearance": None if check is None else check.min_clearance,
         "verify_queries": None if check is None else check.queries,

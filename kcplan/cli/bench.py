@@ -9,7 +9,13 @@ import signal
 import sys
 from pathlib import Path
 
-from kcplan.cli.common import InputError, load_input, positive_float, positive_int
+from kcplan.cli.common import (
+    InputError,
+    load_input,
+    non_negative_float,
+    positive_float,
+    positive_int,
+)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
         args.seed,
         args.time,
         args.simplify,
+        args.progress_interval or None,
     )
     meta = campaign_metadata(
         specs,
@@ -143,6 +150,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action=argparse.BooleanOptionalAction,
         default=True,
         help="simplify returned paths (default on)",
+    )
+    p.add_argument(
+        "--progress-interval",
+        type=non_negative_float,
+        default=0.1,
+        metavar="SECONDS",
+        help="sample the best cost of anytime planners (RRT*, Informed RRT*, SORRT*, AORRTC, "
+        "BIT*) every SECONDS while they solve, for the logs' progress section, Planner "
+        "Arena's progress plots and plots/cost_over_time.png (default 0.1; 0: off)",
     )
     p.add_argument(
         "--scheduler",

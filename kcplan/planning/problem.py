@@ -17,6 +17,7 @@ from ompl import util as ou
 
 from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, check_planner_name
+from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
@@ -159,6 +160,12 @@ class PlanResult:
     counters: dict = field(default_factory=dict)
     problem: Scenario | None = field(default=None, repr=False, compare=False)
     """The scenario planned on (for :meth:`verify`; not written to JSON)."""
+    progress: dict = field(default_factory=dict)
+    """Best cost over time, ``{OMPL progress property: values}`` with ``"time REAL"``
+    (seconds into ``solve()``) and ``"best cost REAL"`` (inf before the first solution);
+    empty unless asked for and the planner reports it (:mod:`kcplan.planning.progress`)."""
+    first_solution_time: float | None = None
+    """Seconds into ``solve()`` of the first exact solution, when progress was recorded."""
 
     def verify(self, tolerance: float = 1e-6) -> PathCheck:
         """Check the path without gaps, independently of every certificate
@@ -188,6 +195,8 @@ class PlanResult:
             "simplify_time": self.simplify_time,
             "seed": self.seed,
             "counters": self.counters,
+            "first_solution_time": self.first_solution_time,
+            "progress": self.progress,
         }
 
 
@@ -199,6 +208,7 @@ def plan(
     simplify: bool = True,
     world: CollisionWorld | None = None,
     first_solution: bool = False,
+    progress: float | None = None,
 ) -> PlanResult:
     """Plan a path for the scenario's robot from start to goal.
 
@@ -220,6 +230,10 @@ def plan(
         Stop at the first exact solution: the optimization objective's cost threshold is
         set to infinity, so asymptotically optimal planners (RRT*, BIT*, ...) report their
         time to a first solution instead of running to the time limit.
+    progress : float, optional
+        Record the best cost every ``progress`` seconds while solving (planners for which
+        :func:`kcplan.planning.progress.reports_progress` holds: RRT*, Informed RRT*,
+        SORRT*, AORRTC, BIT*; ignored for the others).
 
     Returns
     -------
@@ -274,8 +288,16 @@ def plan(
     if first_solution and objective is not None:
         objective.setCostThreshold(ob.Cost(math.inf))
 
+    recorder = None
+    if progress is not None and reports_progress(planner_object):
+        recorder = ProgressRecorder(planner_object, progress)
+        stop = recorder.termination_condition(float(time_limit))
+    else:
+        stop = ob.timedPlannerTerminationCondition(float(time_limit))
     try:
-        ss.solve(ob.timedPlannerTerminationCondition(float(time_limit)))
+        ss.solve(stop)
+        if recorder is not None:
+            recorder.finish()
         if validator is not None:
             validator.raise_error()
         solve_time = float(ss.getLastPlanComputationTime())
@@ -318,4 +340,6 @@ def plan(
         seed,
         counters,
         scenario,
+        recorder.to_json() if recorder is not None else {},
+        recorder.first_solution_time if recorder is not None else None,
     )
