@@ -113,40 +113,39 @@ def _panels(n: int, width: float = 3.6, height: float = 3.0):
 
 
 def plot_cost_over_time(records: Sequence[dict], path: str | os.PathLike) -> None:
-    """Best cost against time of the planners that record progress, one panel per
-    scenario: the median over all runs (drawn once more than half the runs have a
-    solution) and the band between the 25th and 75th percentiles."""
+    """Best cost against time (log scale) of the planners that record progress, one
+    panel per scenario: the median over all runs (drawn once more than half the runs
+    have a solution) and the band between the 25th and 75th percentiles. A certified
+    planner and its twins share a colour: ``kc-*`` solid, ``ca-*`` dotted, stock dashed."""
     runs = [r for r in records if r.get("progress")]
     scenarios = list(dict.fromkeys(r["scenario_name"] for r in runs))
-    fig, axes = _panels(len(scenarios), 4.2, 3.2)
+    planners = _planners(runs)
+    bases = list(dict.fromkeys(p.removeprefix("kc-").removeprefix("ca-") for p in planners))
+    fig, axes = _panels(len(scenarios), 4.4, 3.4)
     for ax, scenario in zip(axes.flat, scenarios, strict=False):
-        mine = [r for r in records if r["scenario_name"] == scenario]
-        limit = max(r["time_limit"] for r in mine)
-        grid = np.linspace(0.0, limit, 300)
-        for i, planner in enumerate(_planners(runs)):
-            theirs = [r for r in mine if r["planner"] == planner]
+        mine = [r for r in runs if r["scenario_name"] == scenario]
+        start = min(r["progress"]["time REAL"][0] for r in mine)
+        grid = np.geomspace(start, max(r["time_limit"] for r in mine), 300)
+        for planner in planners:
+            theirs = [
+                r for r in records if r["scenario_name"] == scenario and r["planner"] == planner
+            ]
             if not any(r.get("progress") for r in theirs):
                 continue
             cost = np.array([[cost_at(r, t) for t in grid] for r in theirs])
             with np.errstate(invalid="ignore"):  # inf - inf between unsolved runs
                 low, mid, high = np.percentile(cost, [25, 50, 75], axis=0)
-            color = _color(planner, i)
-            stock = not planner.startswith(("kc-", "ca-"))
-            ax.step(grid, mid, "--" if stock else "-", where="post", color=color, label=planner)
-            ax.fill_between(
-                grid,
-                low,
-                np.where(np.isfinite(high), high, np.nan),
-                step="post",
-                color=color,
-                alpha=0.2,
-                lw=0,
-            )
+            base = planner.removeprefix("kc-").removeprefix("ca-")
+            color = plt.cm.tab10(bases.index(base) % 10)
+            style = "-" if planner.startswith("kc-") else ":" if planner.startswith("ca-") else "--"
+            ax.step(grid, mid, style, where="post", color=color, label=planner)
+            high = np.where(np.isfinite(high), high, np.nan)
+            ax.fill_between(grid, low, high, step="post", color=color, alpha=0.15, lw=0)
+        ax.set_xscale("log")
         ax.set_title(scenario, fontsize=10)
-        ax.set_xlabel("time [s]")
+        ax.set_xlabel("time into solve() [s]")
         ax.set_ylabel("best cost (path length)")
         ax.grid(alpha=0.3)
-    handles, labels = axes.flat[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), frameon=False)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    axes.flat[0].legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
     save_figure(fig, path)
