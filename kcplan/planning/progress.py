@@ -106,6 +106,9 @@ class ProgressRecorder:
         now = time.perf_counter()
         if not self.samples or now - self._t0 > self.samples[-1][0]:
             self._sample(now)
+        # a solution found in the very last iteration was never seen by the condition
+        if self.first_solution_time is None and math.isfinite(self.samples[-1][1]):
+            self.first_solution_time = self.samples[-1][0]
 
     def to_json(self) -> dict[str, list[float]]:
         """The samples as columns, ``{property name: values}`` (``inf`` stays ``inf``)."""
