@@ -59,7 +59,7 @@ def _solved_value(name: str) -> Callable[[dict], object]:
 RUN_PROPERTIES: tuple[tuple[str, str, Callable[[dict], object]], ...] = (
     # OMPL's own names, so Planner Arena's default plots work
     ("time", "REAL", lambda r: r["time"]),
-    ("time to first solution", "REAL", lambda r: solution_time(r)),
+    ("time to first solution", "REAL", solution_time),
     ("solved", "BOOLEAN", lambda r: r["solved"]),
     ("status", "ENUM", _status),
     ("approximate solution", "BOOLEAN", lambda r: False if r["status"] == "ok" else None),

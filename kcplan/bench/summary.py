@@ -127,7 +127,7 @@ def summarize(records: Sequence[dict]) -> list[dict]:
     for (scenario, planner), runs in groups.items():
         finished = [r for r in runs if r["status"] == "ok"]
         solved = [r for r in finished if r["solved"]]
-        charged = [r["time_limit"] if solution_time(r) is None else solution_time(r) for r in runs]
+        charged = [r["time_limit"] if (t := solution_time(r)) is None else t for r in runs]
 
         def counter(name: str, runs=finished) -> float:
             return _median([r["counters"][name] for r in runs if name in r["counters"]])

@@ -12,6 +12,7 @@ __all__ = [
     "Parser",
     "finite_float",
     "load_input",
+    "non_negative_float",
     "output_file",
     "planner_name",
     "positive_float",

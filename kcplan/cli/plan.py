@@ -25,8 +25,7 @@ def _print_counters(counters: dict) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Plan, print the result and counters, write ``-o``, ``--plot``, ``--animate`` and
-    ``--html``;
-    exit 1 when not solved."""
+    ``--html``; exit 1 when not solved."""
     output_file(args.output, "-o")
     output_file(args.plot, "--plot", (".png",))
     output_file(args.animate, "--animate", (".gif",))

@@ -41,7 +41,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "-o",
         "--output",
         metavar="FILE.png",
-        help="image file (default: beside the scenario, same name, .png; not with --html)",
+        help="image file (default: beside the scenario, same name, .png; with --html, only "
+        "when given)",
     )
-    p.add_argument("--html", metavar="FILE.html", help="write an interactive 3D view instead")
+    p.add_argument("--html", metavar="FILE.html", help="write an interactive 3D view")
     p.set_defaults(handler=run)
