@@ -17,7 +17,7 @@ import plotly.graph_objects as go
 
 from kcplan.files import write_text_atomic
 from kcplan.maps.superquadric import unit_normals
-from kcplan.viz import body_shapes, path_poses
+from kcplan.viz import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
 from kcplan.world.scenario import Obstacle, Scenario
 from kcplan.world.support import box_vertices
@@ -25,8 +25,6 @@ from kcplan.world.support import box_vertices
 __all__ = ["scene_figure", "write_scene_html"]
 
 _SPHERE = convex_hull(unit_normals(3, 160))  # unit sphere: vertices and triangles
-_ANGLES = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
-_CIRCLE = np.column_stack([np.cos(_ANGLES), np.sin(_ANGLES)])  # unit circle, 48 points
 
 
 def _flat(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -39,7 +37,7 @@ def _flat(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _ellipsoid(center, R, axes, n: int) -> tuple[np.ndarray, np.ndarray]:
     if n == 2:
-        return _flat(center + (_CIRCLE * axes) @ R.T)
+        return _flat(ellipse_outline(center, R, axes, 49)[:-1])  # 48 points, not closed
     V, F = _SPHERE
     return center + (V * axes) @ R.T, F
 
