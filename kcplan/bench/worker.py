@@ -27,6 +27,8 @@ def execute(spec: dict) -> dict:
     ``progress`` (best cost over time of anytime planners, see
     :class:`kcplan.planning.progress.ProgressRecorder`; None and empty otherwise),
     ``counters`` (FCL queries and, for kc planners, the validator's counters),
+    ``backend`` (``"kernel"`` or ``"python"``: who checked, see
+    :class:`kcplan.planning.problem.PlannerSpec`),
     ``collides`` / ``min_clearance`` / ``verify_queries`` (gap-free verification; None
     when unsolved), ``memory_mb`` (peak resident set of the worker) and ``wall`` (seconds
     of the whole run).
@@ -51,6 +53,7 @@ def execute(spec: dict) -> dict:
     return {
         "status": "ok",
         "reason": "",
+        "backend": result.backend,
         "solved": result.solved,
         "time": result.time,
         "simplify_time": result.simplify_time,

@@ -25,7 +25,7 @@ from kcplan.planning.guard import Guard, GuardCache
 from kcplan.planning.ladder import GuardLadder
 from kcplan.world.occupancy import CoreOccupancy
 
-__all__ = ["CERTIFICATE_SETS", "EdgeCertifier"]
+__all__ = ["CERTIFICATE_SETS", "COUNTER_NAMES", "EdgeCertifier", "check_certificates"]
 
 CERTIFICATE_SETS = {
     "ca": ("ball",),
@@ -125,8 +125,11 @@ class EdgeCertifier:
     cache : GuardCache, optional
         Shared with the state validity checker (see :meth:`state_valid`).
 
-    Not thread-safe (the world reuses one FCL robot object).
+    Not thread-safe (the world reuses one FCL robot object). Its compiled twin, with the
+    same steps and counters, is :class:`kcplan.planning.kernel.KernelCertifier`.
     """
+
+    backend = "python"
 
     def __init__(
         self,
@@ -148,23 +151,7 @@ class EdgeCertifier:
         core = robot.core_radius > 0.0
         sweep_test = core and _supported(world, "sweep_test", sweep_test, "sweep_core_collides")
         occupancy = core and _supported(world, "occupancy", occupancy, "ball_collides", "scenario")
-        if "region" in certificates and not regions:
-            raise ValueError(
-                "certificates: 'region' needs a world with free_regions(pose, horizon)"
-            )
-        if "polytope" in certificates and not robot.is_single:
-            raise ValueError(
-                "certificates: 'polytope' (the paper's bound) needs one body centred at the "
-                f"robot's origin, got {robot.describe()}"
-            )
-        if fallback not in ("bisection", "discrete"):
-            raise ValueError(f"fallback: expected 'bisection' or 'discrete', got {fallback!r}")
-        unknown = [c for c in certificates if c not in CERTIFICATE_NAMES]
-        if unknown or not certificates:
-            raise ValueError(
-                f"certificates: expected names from {', '.join(CERTIFICATE_NAMES)}, "
-                f"got {list(certificates)}"
-            )
+        check_certificates(certificates, robot, regions, fallback)
         if hasattr(world, "safe_body_clearances"):
             self._body_clearances = world.safe_body_clearances
         elif len(robot) == 1:  # a one-body world may offer safe_clearance alone
@@ -224,6 +211,8 @@ class EdgeCertifier:
         remembered so that a later edge ending there skips its end-state query.
         ``key`` is ``pose.tobytes()`` when the caller has it."""
         p = np.asarray(pose, dtype=float)
+        if not _is_pose(p, self.n):
+            return False  # a pose that is not finite is never free
         key = p.tobytes() if key is None else key
         known = self.cache.validity(key)
         if known is not None:
@@ -289,11 +278,14 @@ class EdgeCertifier:
         return False
 
     def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
-        """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs)."""
+        """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs); an
+        edge with a pose that is not finite is rejected (``rejected_end_state``)."""
         c = self.counters
         c["edges"] += 1
         p1 = np.asarray(pose1, dtype=float)
         p2 = np.asarray(pose2, dtype=float)
+        if not (_is_pose(p1, self.n) and _is_pose(p2, self.n)):
+            return self._reject("rejected_end_state")  # never free
         k1, k2 = p1.tobytes(), p2.tobytes()
         cache, grid = self.cache, self._occupancy()
         if grid is not None and grid.blocked(p2):
@@ -379,6 +371,33 @@ class EdgeCertifier:
             if self.world.in_collision(edge.pose(s)):
                 return self._reject("rejected_guard")
         return True
+
+
+def _is_pose(p: np.ndarray, n: int) -> bool:
+    """Finite numbers and, in 3D, a quaternion that can be normalised."""
+    return bool(np.isfinite(p).all()) and (n == 2 or float(p[3:] @ p[3:]) > 0.0)
+
+
+def check_certificates(
+    certificates: Sequence[str], robot: Robot, regions: bool, fallback: str
+) -> None:
+    """Raise ``ValueError`` (one line) unless the certificate names, the robot and the
+    fallback fit together; ``regions``: the world offers region queries."""
+    if "region" in certificates and not regions:
+        raise ValueError("certificates: 'region' needs a world with free_regions(pose, horizon)")
+    if "polytope" in certificates and not robot.is_single:
+        raise ValueError(
+            "certificates: 'polytope' (the paper's bound) needs one body centred at the "
+            f"robot's origin, got {robot.describe()}"
+        )
+    if fallback not in ("bisection", "discrete"):
+        raise ValueError(f"fallback: expected 'bisection' or 'discrete', got {fallback!r}")
+    unknown = [c for c in certificates if c not in CERTIFICATE_NAMES]
+    if unknown or not certificates:
+        raise ValueError(
+            f"certificates: expected names from {', '.join(CERTIFICATE_NAMES)}, "
+            f"got {list(certificates)}"
+        )
 
 
 def _supported(world, option: str, value: bool | None, *needs: str) -> bool:

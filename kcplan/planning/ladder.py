@@ -114,6 +114,11 @@ class GuardLadder:
         self._levels = levels
         self.scale = float(a.max())
 
+    @property
+    def scaled_rows(self) -> list[np.ndarray]:
+        """Per level, the rows ``A_i / c_i`` of ``P_eps``, shape ``(rows, 3 or 6)``."""
+        return list(self._scaled)
+
     def level_for(self, clearance: float) -> int:
         """Index of the largest inflation a guard with this clearance allows, or -1."""
         return bisect.bisect_right(self._levels, clearance / self.scale) - 1

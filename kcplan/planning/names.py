@@ -18,6 +18,11 @@ the two-argument ``checkMotion``: each is offered stock, as ``kc-<name>`` and as
 LAST_VALID = ("kpiece1", "bkpiece1", "lbkpiece1")
 """OMPL planners that ask the motion validator for the last valid state: offered stock only."""
 
+STOCK = ("rrtconnect", "prm", "rrtconnect-fine", "prm-fine", *CERTIFIABLE, *LAST_VALID)
+"""Stock OMPL planners: OMPL's discrete motion validator on the kernel's compiled collision
+query; each also as ``<name>-fcl``, the same on python-fcl (what a Python user writes by
+hand)."""
+
 PLANNER_NAMES = (
     "kc-rrtconnect",
     "kc-prm",
@@ -26,12 +31,10 @@ PLANNER_NAMES = (
     "kc-rrtconnect-paper",
     "kc-prm-paper",
     "kc-rrtconnect-discrete",
-    "rrtconnect",
-    "prm",
-    "rrtconnect-fine",
-    "prm-fine",
-    *CERTIFIABLE,
-    *LAST_VALID,
+    "kc-rrtconnect-py",
+    "kc-prm-py",
+    *STOCK,
+    *(f"{name}-fcl" for name in STOCK),
     *(f"kc-{name}" for name in CERTIFIABLE),
     *(f"ca-{name}" for name in CERTIFIABLE),
 )

@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
 from kcplan.planning.certifier import CERTIFICATE_SETS
-from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, check_planner_name
+from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, STOCK, check_planner_name
 from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
@@ -33,7 +33,10 @@ class PlannerSpec:
 
     ``certificates`` is None for a stock planner (OMPL's discrete validator at
     ``resolution``, OMPL's default when None); otherwise the names the
-    :class:`KCMotionValidator` uses (:data:`CERTIFICATE_SETS`).
+    :class:`KCMotionValidator` uses (:data:`CERTIFICATE_SETS`). ``backend`` says who
+    checks: ``"kernel"`` (the compiled kernel on coal: the certifier of a kc planner, the
+    collision query of a stock one) or ``"python"`` (the Python certifier on python-fcl;
+    for a stock planner the python-fcl state checker).
     """
 
     make: type
@@ -43,6 +46,7 @@ class PlannerSpec:
     resolution: float | None = None  # OMPL's state validity checking resolution (stock)
     range_factor: float | None = None  # RRT-Connect range, fraction of the maximum extent
     neighbors: int | None = None  # PRM's maximum nearest neighbours (OMPL default 10)
+    backend: str = "kernel"
 
     @property
     def kc(self) -> bool:
@@ -83,6 +87,19 @@ PLANNERS: dict[str, PlannerSpec] = {
         "RRT-Connect with endpoint guards, then OMPL-style sampling (the design card's "
         "plain variant; not exact)",
     ),
+    "kc-rrtconnect-py": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation: kc-rrtconnect decided by the Python certifier on python-fcl "
+        "(the reference the compiled kernel replaces)",
+        backend="python",
+    ),
+    "kc-prm-py": PlannerSpec(
+        og.PRM,
+        _KC,
+        description="ablation: kc-prm decided by the Python certifier on python-fcl",
+        backend="python",
+    ),
     "rrtconnect": PlannerSpec(og.RRTConnect, description="stock RRT-Connect"),
     "prm": PlannerSpec(og.PRM, description="stock PRM"),
     "rrtconnect-fine": PlannerSpec(
@@ -121,15 +138,38 @@ for _name in CERTIFIABLE:
     PLANNERS[f"ca-{_name}"] = PlannerSpec(
         _make, _CA, description=f"ablation: kc-{_name} with the clearance ball only"
     )
+for _name in STOCK:
+    _spec = PLANNERS[_name]
+    PLANNERS[f"{_name}-fcl"] = replace(
+        _spec,
+        description=f"{_spec.description}, states checked by python-fcl (by hand in Python)",
+        backend="python",
+    )
 PLANNERS = {name: PLANNERS[name] for name in PLANNER_NAMES}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
-default discrete motion validator at the default resolution (1 % of the space extent).
-The ``kc-*``, ``ca-*`` and ``kc-*-paper`` planners differ only in their certificates."""
+default discrete motion validator at the default resolution (1 % of the space extent),
+checking states with the kernel's compiled collision query (``*-fcl``: python-fcl).
+The ``kc-*``, ``ca-*`` and ``kc-*-paper`` planners differ only in their certificates,
+``kc-*-py`` only in their backend."""
 if tuple(PLANNERS) != PLANNER_NAMES:  # pragma: no cover - keeps the CLI's list honest
     raise ImportError("kcplan.planning.names.PLANNER_NAMES is out of date")
 
 _SEEDED: list[int] = []
 ou.setLogLevel(ou.LOG_WARN)
+
+
+def _kernel_checker(kernel, n: int):
+    """A state validity checker on the kernel's collision query (one call per state)."""
+    if n == 2:
+        collides2 = kernel.in_collision_se2
+        return lambda s: not collides2(s.getX(), s.getY(), s.getYaw())
+    collides3 = kernel.in_collision_se3
+
+    def state_valid(s) -> bool:
+        r = s.rotation()
+        return not collides3(s.getX(), s.getY(), s.getZ(), r.x, r.y, r.z, r.w)
+
+    return state_valid
 
 
 def seed_ompl(seed: int) -> bool:
@@ -166,6 +206,8 @@ class PlanResult:
     empty unless asked for and the planner reports it (:mod:`kcplan.planning.progress`)."""
     first_solution_time: float | None = None
     """Seconds into ``solve()`` of the first exact solution, when progress was recorded."""
+    backend: str = "kernel"
+    """Who checked: ``"kernel"`` (compiled, coal) or ``"python"`` (python-fcl)."""
 
     def verify(self, tolerance: float = 1e-6) -> PathCheck:
         """Check the path without gaps, independently of every certificate
@@ -197,6 +239,7 @@ class PlanResult:
             "counters": self.counters,
             "first_solution_time": self.first_solution_time,
             "progress": self.progress,
+            "backend": self.backend,
         }
 
 
@@ -258,9 +301,13 @@ def plan(
     checker_calls = [0]
     validator = None
     if spec.kc:
-        validator = KCMotionValidator(si, scenario.robot, world, spec.certificates, spec.fallback)
+        validator = KCMotionValidator(
+            si, world.robot, world, spec.certificates, spec.fallback, backend=spec.backend
+        )
         si.setMotionValidator(validator)
         state_valid = validator.state_valid  # shares the validator's guard cache
+    elif spec.backend == "kernel":
+        state_valid = _kernel_checker(world.kernel, n)
     else:
 
         def state_valid(state) -> bool:
@@ -342,4 +389,5 @@ def plan(
         scenario,
         recorder.to_json() if recorder is not None else {},
         recorder.first_solution_time if recorder is not None else None,
+        spec.backend,
     )

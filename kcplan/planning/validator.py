@@ -31,8 +31,10 @@ from ompl import base as ob
 
 from kcplan.geometry.robot import Robot
 from kcplan.planning.certifier import EdgeCertifier
+from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import state_pose
+from kcplan.world.collision import CollisionWorld
 
 __all__ = ["KCMotionValidator"]
 
@@ -70,6 +72,13 @@ class KCMotionValidator(ob.MotionValidator):
         Reject an edge whose robot core (ball of radius ``min(a)`` for one body) sweeps into an
         obstacle with one collision query before measuring guards (default: when the
         world has ``sweep_core_collides``).
+    backend : {"kernel", "python"}, optional
+        Who decides: the compiled kernel (:class:`kcplan.planning.kernel.KernelCertifier`,
+        on coal; the default for a :class:`kcplan.CollisionWorld`, whose robot it
+        certifies) or the Python reference (:class:`kcplan.planning.certifier.EdgeCertifier`,
+        on python-fcl; the default, and the only choice, for a world written in Python).
+        Both decide every edge by the same steps; neither accepts an edge to a pose that
+        is not finite.
     """
 
     def __init__(
@@ -83,25 +92,43 @@ class KCMotionValidator(ob.MotionValidator):
         horizon: float | None = None,
         max_guards: int = 64,
         sweep_test: bool | None = None,
+        backend: str | None = None,
     ):
         super().__init__(si)
         self.si = si
         self.space = si.getStateSpace()
+        robot = Robot.of(robot)
         ladder = None
         if certificates is not None and "polytope" in certificates:
-            ladder = GuardLadder(Robot.of(robot).semi_axes, inflations)
-        self.certifier = EdgeCertifier(
-            world,
-            robot,
-            certificates,
-            ladder,
-            horizon,
-            fallback,
-            max_guards,
-            sweep_test,
-        )
+            ladder = GuardLadder(robot.semi_axes, inflations)
+        compiled = isinstance(world, CollisionWorld)
+        if backend is None:
+            backend = "kernel" if compiled else "python"
+        if backend not in ("kernel", "python"):
+            raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
+        if backend == "kernel" and not compiled:
+            raise ValueError(
+                "backend: 'kernel' needs a kcplan.CollisionWorld, got "
+                f"{type(world).__name__} (use backend='python' for a world written in Python)"
+            )
+        if backend == "kernel" and world.robot is not robot and robot.to_spec() != world.robot.to_spec():
+            raise ValueError("robot: the kernel certifies the world's own robot; got another")
+        options = (certificates, ladder, horizon, fallback, max_guards, sweep_test)
+        if backend == "kernel":
+            self.certifier = KernelCertifier(world, *options)
+        else:
+            certificates, ladder, horizon, fallback, max_guards, sweep_test = options
+            self.certifier = EdgeCertifier(
+                world, robot, certificates, ladder, horizon, fallback, max_guards, sweep_test
+            )
+        self.backend = backend
+        """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
         self.error: Exception | None = None
+        if backend == "kernel" and fallback != "discrete":
+            # the hot path: one call into the kernel with the two poses, nothing else
+            self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
+            self.state_valid = self._valid_kernel_se2 if self.n == 2 else self._valid_kernel_se3
 
     @property
     def counters(self) -> dict:
@@ -115,6 +142,37 @@ class KCMotionValidator(ob.MotionValidator):
         """A state validity check that shares the validator's cache: use it as the
         setup's checker so that edges ending at checked states skip that query."""
         return self.certifier.state_valid(state_pose(state, self.n))
+
+    def _check_kernel_se2(self, s1, s2) -> bool:
+        try:
+            return self.certifier.check_se2(
+                s1.getX(), s1.getY(), s1.getYaw(), s2.getX(), s2.getY(), s2.getYaw()
+            )
+        except Exception as err:  # noqa: BLE001 - see checkMotion
+            return self._fail(err)
+
+    def _check_kernel_se3(self, s1, s2) -> bool:
+        try:
+            r1, r2 = s1.rotation(), s2.rotation()
+            return self.certifier.check_se3(
+                s1.getX(), s1.getY(), s1.getZ(), r1.x, r1.y, r1.z, r1.w,
+                s2.getX(), s2.getY(), s2.getZ(), r2.x, r2.y, r2.z, r2.w, 0.01,
+            )  # fmt: skip
+        except Exception as err:  # noqa: BLE001 - see checkMotion
+            return self._fail(err)
+
+    def _valid_kernel_se2(self, state) -> bool:
+        return self.certifier.state_valid_se2(state.getX(), state.getY(), state.getYaw())
+
+    def _valid_kernel_se3(self, state) -> bool:
+        r = state.rotation()
+        return self.certifier.state_valid_se3(
+            state.getX(), state.getY(), state.getZ(), r.x, r.y, r.z, r.w
+        )
+
+    def _fail(self, err: Exception) -> bool:
+        self.error = self.error or err
+        return False
 
     def checkMotion(self, s1, s2) -> bool:  # noqa: N802 - OMPL's name
         if self.error is not None:
@@ -130,8 +188,7 @@ class KCMotionValidator(ob.MotionValidator):
                 self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
             )
         except Exception as err:  # through PRM's C++ threads an exception aborts
-            self.error = err  # rejecting is always safe; raise_error() re-raises after solve
-            return False
+            return self._fail(err)  # rejecting is always safe; raise_error() re-raises it
 
     def raise_error(self) -> None:
         """Re-raise the first exception a ``checkMotion`` call caught, if any. An exception

@@ -33,6 +33,7 @@ import fcl
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kcplan._kernel import _core, build_kernel_world
 from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
@@ -158,14 +159,42 @@ class CollisionWorld:
         )
         self._horizon_boxes: dict[tuple[int, float], fcl.CollisionObject] = {}
         self._pair_request = fcl.DistanceRequest(enable_nearest_points=True)
-        self.counters = {
+        self._kernel: _core.World | None = None
+        self._fcl_counters = {
             "collision_queries": 0,
             "distance_queries": 0,
             "region_queries": 0,
             "region_pairs": 0,
             "body_queries": 0,
         }
-        self.body_query_counts = [0] * len(robot.bodies)
+        self._fcl_body_counts = [0] * len(robot.bodies)
+
+    @property
+    def counters(self) -> dict[str, int]:
+        """Queries issued through this world, python-fcl's and the kernel's together
+        (see the class notes)."""
+        if self._kernel is None:
+            return dict(self._fcl_counters)
+        compiled = self._kernel.counters
+        return {key: value + compiled[key] for key, value in self._fcl_counters.items()}
+
+    @property
+    def body_query_counts(self) -> list[int]:
+        """``body_queries`` per body, python-fcl's and the kernel's together."""
+        if self._kernel is None:
+            return list(self._fcl_body_counts)
+        compiled = self._kernel.body_query_counts
+        return [a + b for a, b in zip(self._fcl_body_counts, compiled, strict=True)]
+
+    @property
+    def kernel(self) -> _core.World:
+        """The same world in the compiled kernel (:mod:`kcplan._kernel`), built on first
+        use: the same obstacles as coal geometry in one broad phase, the same robot, and
+        coal's own error allowance (:data:`kcplan._kernel.COAL_CLEARANCE_RTOL`). Its
+        queries are counted in :attr:`counters`."""
+        if self._kernel is None:
+            self._kernel = build_kernel_world(self.scenario, self.robot, self._half_height)
+        return self._kernel
 
     def _fcl_parts(self, ob: Obstacle) -> list[tuple]:
         n, identity = self.dimension, fcl.Transform()
@@ -199,9 +228,11 @@ class CollisionWorld:
 
     def reset_counters(self) -> None:
         """Set the query counters to zero."""
-        for key in self.counters:
-            self.counters[key] = 0
-        self.body_query_counts = [0] * len(self._bodies)
+        for key in self._fcl_counters:
+            self._fcl_counters[key] = 0
+        self._fcl_body_counts = [0] * len(self._bodies)
+        if self._kernel is not None:
+            self._kernel.reset_counters()
 
     def _place(self, pose: ArrayLike) -> None:
         """Move every body's FCL object to the robot pose ``pose``."""
@@ -212,13 +243,18 @@ class CollisionWorld:
                 f"got shape {p.shape}"
             )
         # plain floats: numpy costs microseconds per call on 4-vectors
+        values = p.tolist()
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"pose: expected finite numbers, got {values}")
         if self.dimension == 2:
-            x, y, yaw = p.tolist()
+            x, y, yaw = values
             t, half = (x, y, 0.0), 0.5 * yaw
             q = (0.0, 0.0, math.sin(half), math.cos(half))
         else:
-            x, y, z, qx, qy, qz, qw = p.tolist()
+            x, y, z, qx, qy, qz, qw = values
             norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+            if norm == 0.0:
+                raise ValueError("pose: expected a non-zero quaternion, got [0, 0, 0, 0]")
             t, q = (x, y, z), (qx / norm, qy / norm, qz / norm, qw / norm)
         if self._single:
             self._bodies[0].setTransform(
@@ -232,14 +268,14 @@ class CollisionWorld:
             body.setTransform(fcl.Transform(np.array([bw, bx, by, bz]), centre))  # [w, x, y, z]
 
     def _count_body(self, k: int) -> None:
-        self.counters["body_queries"] += 1
-        self.body_query_counts[k] += 1
+        self._fcl_counters["body_queries"] += 1
+        self._fcl_body_counts[k] += 1
 
     def in_collision(self, pose: ArrayLike) -> bool:
         """Whether some body of the robot at ``pose`` touches or overlaps an obstacle
         (one collision query; one FCL query per body until a body collides)."""
         self._place(pose)
-        self.counters["collision_queries"] += 1
+        self._fcl_counters["collision_queries"] += 1
         if not self._objects:
             return False
         for k, body in enumerate(self._bodies):
@@ -261,7 +297,7 @@ class CollisionWorld:
         and may overestimate by up to :data:`CLEARANCE_RTOL` relative plus
         :data:`CLEARANCE_ATOL`: see :meth:`safe_body_clearances`."""
         self._place(pose)
-        self.counters["distance_queries"] += 1
+        self._fcl_counters["distance_queries"] += 1
         if not self._objects:
             return np.full(len(self._bodies), math.inf)
         out = np.empty(len(self._bodies))
@@ -303,7 +339,7 @@ class CollisionWorld:
         """
         n = self.dimension
         self._place(pose)
-        self.counters["region_queries"] += 1
+        self._fcl_counters["region_queries"] += 1
         horizon = float(horizon)
         if not self._objects:
             return (FreeRegion.empty(n, math.inf),) * len(self._bodies)
@@ -321,9 +357,9 @@ class CollisionWorld:
             box.setTranslation(body.getTranslation())
             near.clear()
             self._manager.collide(box, None, collect)
-            self.counters["region_pairs"] += len(near)
+            self._fcl_counters["region_pairs"] += len(near)
             if not near:  # open space: the clearance to everything is the better horizon
-                self.counters["distance_queries"] += 1
+                self._fcl_counters["distance_queries"] += 1
                 data = fcl.DistanceData()
                 self._manager.distance(body, data, fcl.defaultDistanceCallback)
                 d = max(float(data.result.min_distance), 0.0)
@@ -373,7 +409,7 @@ class CollisionWorld:
     def ball_collides(self, center: ArrayLike, radius: float) -> bool:
         """Whether the ball (2D: disc) of ``radius`` about ``center`` meets an obstacle
         (one FCL collision query; builds :class:`kcplan.world.occupancy.CoreOccupancy`)."""
-        self.counters["collision_queries"] += 1
+        self._fcl_counters["collision_queries"] += 1
         if not self._objects:
             return False
         c = np.zeros(3)
@@ -392,7 +428,7 @@ class CollisionWorld:
         n = self.dimension
         a = [float(v) for v in t1[:n]] + [0.0] * (3 - n)
         b = [float(v) for v in t2[:n]] + [0.0] * (3 - n)
-        self.counters["collision_queries"] += 1
+        self._fcl_counters["collision_queries"] += 1
         if not self._objects:
             return False
         dx, dy, dz = b[0] - a[0], b[1] - a[1], b[2] - a[2]

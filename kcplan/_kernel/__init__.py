@@ -1,0 +1,110 @@
+"""The compiled certification kernel: C++17 on coal, bound with nanobind.
+
+One ``checkMotion`` of a kc planner is one call into :class:`EdgeCertifier`, which does
+the whole decision in C++ (guard cache, occupancy grid, core sweep, guards, certificates,
+advancement) against :class:`World`, the scenario's obstacles as coal geometry in one
+broad phase. Each C++ class has a Python twin that is the readable reference and is tested
+against it edge by edge:
+
+================================= ==========================================
+C++ (``kcplan/_kernel/``)          Python twin
+================================= ==========================================
+``pose.hpp`` ``Pose``, ``Edge``    :mod:`kcplan.geometry.pose`
+``robot.hpp`` ``Robot``            :mod:`kcplan.geometry.robot`
+``world.hpp`` ``World``            :class:`kcplan.world.CollisionWorld`
+``occupancy.hpp``                  :mod:`kcplan.world.occupancy`
+``guard.hpp``                      :mod:`kcplan.planning.guard`
+``certificates.hpp``               :mod:`kcplan.planning.certificates`
+``certifier.hpp`` ``EdgeCertifier`` :mod:`kcplan.planning.certifier`
+================================= ==========================================
+
+Conventions: poses are flat, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]`` (scalar
+last), lengths in the scenario's unit. Errors (a pose that is not finite given to a world
+query, degenerate geometry, a wrong number of pose values) raise ``ValueError`` with one
+line saying what was expected; nothing aborts the process. An edge or state with a
+non-finite pose is never free: the certifier rejects it. Nothing here is thread-safe: a
+world reuses its coal objects and solvers between queries, so use one world (and its
+certifiers) per thread.
+
+The extension links coal and Boost from the installed ``libcoal`` wheel (``RPATH``
+``site-packages/cmeel.prefix/lib``), so it imports in a fresh process with no environment
+variables.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kcplan._kernel import _core
+from kcplan._kernel._core import EdgeCertifier, Robot, World
+
+__all__ = [
+    "COAL_CLEARANCE_ATOL",
+    "COAL_CLEARANCE_RTOL",
+    "EdgeCertifier",
+    "Robot",
+    "World",
+    "build_kernel_world",
+    "kernel_robot",
+]
+
+COAL_CLEARANCE_RTOL = 2e-3
+"""Relative error allowed for coal's GJK distances (the same allowance as python-fcl's,
+:data:`kcplan.world.collision.CLEARANCE_RTOL`). Measured against exact distances by
+``scripts/coal_distance_error.py`` (``benchmarks/RESULTS.md``, section 8): see there for
+the worst excess seen; the allowance is far above it."""
+COAL_CLEARANCE_ATOL = 1e-6
+"""Absolute error allowed for coal's distances, as a fraction of the scene's size (the
+largest side of the bounds, or the robot's reach if larger)."""
+
+
+def kernel_robot(robot) -> _core.Robot:
+    """The kernel's twin of a :class:`kcplan.geometry.robot.Robot`."""
+    n = robot.dimension
+    semi_axes = [float(v) for b in robot.bodies for v in b.semi_axes]
+    poses = [float(v) for b in robot.bodies for v in b.pose]
+    return _core.Robot(n, semi_axes, poses)
+
+
+def _embed(rotation: np.ndarray) -> list[float]:
+    R = np.eye(3)
+    R[: rotation.shape[0], : rotation.shape[1]] = rotation
+    return R.ravel().tolist()
+
+
+def build_kernel_world(scenario, robot, half_height: float) -> _core.World:
+    """The scenario's obstacles and ``robot`` as a kernel :class:`World`.
+
+    Parameters
+    ----------
+    scenario : kcplan.world.Scenario
+    robot : kcplan.geometry.robot.Robot
+    half_height : float
+        Half height of the 2D obstacles' prisms (as in the python-fcl world).
+    """
+    n = scenario.dimension
+    size = max(float(np.ptp(scenario.bounds, axis=0).max()), robot.reach)
+    world = _core.World(
+        kernel_robot(robot), float(half_height), COAL_CLEARANCE_RTOL, COAL_CLEARANCE_ATOL * size
+    )
+    for ob in scenario.obstacles:
+        centre = [float(v) for v in ob.center] + [0.0] * (3 - n)
+        if ob.kind in ("polygon", "box") and n == 2:
+            for piece in ob.pieces:
+                world.add_prism(np.asarray(piece, dtype=float).ravel().tolist())
+        elif ob.kind == "box":
+            world.add_box(centre, _embed(ob.rotation), [float(v) for v in ob.extents])
+        elif ob.kind in ("circle", "sphere"):
+            world.add_sphere(centre, float(ob.extents[0]))
+        elif ob.kind in ("ellipse", "ellipsoid"):
+            axes = [float(v) for v in ob.extents]
+            world.add_ellipsoid(centre, _embed(ob.rotation), axes if n == 3 else [*axes, min(axes)])
+        elif ob.kind == "convex":
+            world.add_convex(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
+        elif ob.kind == "mesh":
+            world.add_mesh(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
+        else:  # pragma: no cover - the scenario loader knows no other kind
+            raise ValueError(f"{ob.label}: unknown obstacle kind {ob.kind!r}")
+    world.finalize()
+    return world
+

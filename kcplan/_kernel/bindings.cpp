@@ -1,0 +1,238 @@
+// Python bindings of the kernel: thin wrappers, no logic. Every C++ exception becomes a
+// Python exception (std::invalid_argument -> ValueError) through nanobind.
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/unique_ptr.h>
+#include <nanobind/stl/vector.h>
+
+#include "certifier.hpp"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+using kcplan::Pose;
+
+namespace {
+
+Pose pose_of(const std::vector<double>& p, int dimension) {
+  const int size = kcplan::pose_size(dimension);
+  if (static_cast<int>(p.size()) != size)
+    throw std::invalid_argument("pose: expected " + std::to_string(size) + " numbers in " +
+                                std::to_string(dimension) + "D, got " + std::to_string(p.size()));
+  return Pose::from_flat(p.data(), size);
+}
+
+Pose se2(double x, double y, double yaw) {
+  const double p[3] = {x, y, yaw};
+  return Pose::from_flat(p, 3);
+}
+
+Pose se3(double x, double y, double z, double qx, double qy, double qz, double qw) {
+  const double p[7] = {x, y, z, qx, qy, qz, qw};
+  return Pose::from_flat(p, 7);
+}
+
+void require(const kcplan::World& w, int dimension) {
+  if (w.robot().dimension() != dimension)
+    throw std::invalid_argument("pose: this world is " + std::to_string(w.robot().dimension()) +
+                                "D");
+}
+
+nb::dict world_counters(const kcplan::World& w) {
+  nb::dict d;
+  d["collision_queries"] = w.counters.collision_queries;
+  d["distance_queries"] = w.counters.distance_queries;
+  d["region_queries"] = w.counters.region_queries;
+  d["region_pairs"] = w.counters.region_pairs;
+  d["body_queries"] = w.counters.body_queries;
+  return d;
+}
+
+nb::dict certifier_counters(const kcplan::CertifierCounters& c) {
+  nb::dict d;
+#define KC_COUNTER(name) d[#name] = c.name
+  KC_COUNTER(edges); KC_COUNTER(rejected); KC_COUNTER(rejected_end_state);
+  KC_COUNTER(rejected_sweep); KC_COUNTER(rejected_occupancy); KC_COUNTER(rejected_guard);
+  KC_COUNTER(not_proven); KC_COUNTER(certified_by_endpoints); KC_COUNTER(certified_one_guard);
+  KC_COUNTER(guards); KC_COUNTER(endpoint_guards); KC_COUNTER(cached_guards);
+  KC_COUNTER(bisection_nodes); KC_COUNTER(collision_queries); KC_COUNTER(occupancy_rejections);
+  KC_COUNTER(occupancy_queries);
+#undef KC_COUNTER
+  return d;
+}
+
+nb::list guard_bodies(const kcplan::Guard& g) {
+  nb::list bodies;
+  for (const kcplan::BodyGuard& b : g.bodies) {
+    nb::list planes;
+    for (const kcplan::PlaneRow& p : b.planes)
+      planes.append(nb::make_tuple(p.nx, p.ny, p.nz, p.slack, p.clearance));
+    bodies.append(nb::make_tuple(b.clearance, planes, b.horizon));
+  }
+  return bodies;
+}
+
+}  // namespace
+
+NB_MODULE(_core, m) {
+  m.doc() = "kcplan's compiled certification kernel (see kcplan._kernel).";
+
+  nb::class_<kcplan::Robot>(m, "Robot")
+      .def(nb::init<int, const std::vector<double>&, const std::vector<double>&>(),
+           "dimension"_a, "semi_axes"_a, "poses"_a)
+      .def_prop_ro("dimension", &kcplan::Robot::dimension)
+      .def("__len__", &kcplan::Robot::size)
+      .def_prop_ro("is_single", &kcplan::Robot::is_single)
+      .def_prop_ro("core_radius", &kcplan::Robot::core_radius)
+      .def_prop_ro("reach", &kcplan::Robot::reach)
+      .def_prop_ro("levers", [](const kcplan::Robot& r) {
+        std::vector<double> out;
+        for (const kcplan::Body& b : r.bodies()) out.push_back(b.lever());
+        return out;
+      });
+
+  nb::class_<kcplan::World>(m, "World")
+      .def(nb::init<const kcplan::Robot&, double, double, double>(), "robot"_a,
+           "half_height"_a, "rtol"_a, "atol"_a)
+      .def("add_prism", &kcplan::World::add_prism, "xy"_a)
+      .def("add_box", &kcplan::World::add_box, "centre"_a, "rotation"_a, "half"_a)
+      .def("add_convex", &kcplan::World::add_convex, "vertices"_a, "triangles"_a)
+      .def("add_sphere", &kcplan::World::add_sphere, "centre"_a, "radius"_a)
+      .def("add_ellipsoid", &kcplan::World::add_ellipsoid, "centre"_a, "rotation"_a,
+           "extents"_a)
+      .def("add_mesh", &kcplan::World::add_mesh, "vertices"_a, "triangles"_a)
+      .def("finalize", &kcplan::World::finalize)
+      .def_prop_ro("n_objects", &kcplan::World::n_objects)
+      .def_prop_ro("dimension", [](const kcplan::World& w) { return w.robot().dimension(); })
+      .def_prop_ro("atol", &kcplan::World::atol)
+      .def_prop_ro("rtol", &kcplan::World::rtol)
+      .def("in_collision",
+           [](kcplan::World& w, const std::vector<double>& p) {
+             return w.in_collision(pose_of(p, w.robot().dimension()));
+           }, "pose"_a)
+      .def("in_collision_se2",
+           [](kcplan::World& w, double x, double y, double yaw) {
+             require(w, 2);
+             return w.in_collision(se2(x, y, yaw));
+           })
+      .def("in_collision_se3",
+           [](kcplan::World& w, double x, double y, double z, double qx, double qy, double qz,
+              double qw) {
+             require(w, 3);
+             return w.in_collision(se3(x, y, z, qx, qy, qz, qw));
+           })
+      .def("body_distances",
+           [](kcplan::World& w, const std::vector<double>& p) {
+             std::vector<double> out(w.robot().size());
+             w.body_distances(pose_of(p, w.robot().dimension()), out.data());
+             return out;
+           }, "pose"_a)
+      .def("safe_body_clearances",
+           [](kcplan::World& w, const std::vector<double>& p) {
+             std::vector<double> out(w.robot().size());
+             w.safe_body_clearances(pose_of(p, w.robot().dimension()), out.data());
+             return out;
+           }, "pose"_a)
+      .def("free_regions",
+           [](kcplan::World& w, const std::vector<double>& p, double horizon) {
+             if (!(horizon >= 0.0)) throw std::invalid_argument("horizon: expected a number >= 0");
+             std::vector<kcplan::FreeRegion> regions;
+             const bool free = w.free_regions(pose_of(p, w.robot().dimension()), horizon, regions);
+             nb::list out;
+             for (const kcplan::FreeRegion& r : regions) {
+               nb::list planes;
+               for (const kcplan::Plane& q : r.planes)
+                 planes.append(nb::make_tuple(q.n[0], q.n[1], q.n[2], q.offset, q.clearance));
+               out.append(nb::make_tuple(planes, r.horizon));
+             }
+             return nb::make_tuple(free, out);
+           }, "pose"_a, "horizon"_a)
+      .def("ball_collides", &kcplan::World::ball_collides, "centre"_a, "radius"_a)
+      .def("sweep_core_collides", &kcplan::World::sweep_core_collides, "a"_a, "b"_a, "radius"_a)
+      .def_prop_ro("counters", &world_counters)
+      .def_prop_ro("body_query_counts", [](const kcplan::World& w) { return w.body_query_counts; })
+      .def("reset_counters", [](kcplan::World& w) {
+        w.counters = kcplan::WorldCounters{};
+        std::fill(w.body_query_counts.begin(), w.body_query_counts.end(), 0);
+      });
+
+  nb::class_<kcplan::EdgeCertifier>(m, "EdgeCertifier")
+      .def(
+          "__init__",
+          [](kcplan::EdgeCertifier* self, kcplan::World& world,
+             const std::vector<std::string>& certificates, bool discrete, int max_guards,
+             double horizon, bool sweep_test, bool occupancy, std::array<double, 3> low,
+             std::array<double, 3> high, std::size_t cache_entries,
+             const std::vector<double>& levels, const std::vector<std::vector<double>>& rows,
+             double scale) {
+            kcplan::CertifierOptions o;
+            o.certificates = certificates, o.discrete = discrete, o.max_guards = max_guards;
+            o.horizon = horizon, o.sweep_test = sweep_test, o.occupancy = occupancy;
+            o.low = low, o.high = high, o.cache_entries = cache_entries;
+            std::unique_ptr<kcplan::KCPolytope> polytope;
+            if (!levels.empty())
+              polytope = std::make_unique<kcplan::KCPolytope>(
+                  levels, rows, world.robot().dimension() == 2 ? 3 : 6, scale);
+            new (self) kcplan::EdgeCertifier(world, o, std::move(polytope));
+          },
+          "world"_a, "certificates"_a, "discrete"_a, "max_guards"_a, "horizon"_a,
+          "sweep_test"_a, "occupancy"_a, "low"_a, "high"_a, "cache_entries"_a,
+          "ladder_levels"_a, "ladder_rows"_a, "ladder_scale"_a, nb::keep_alive<1, 2>())
+      .def("check",
+           [](kcplan::EdgeCertifier& c, const std::vector<double>& p1,
+              const std::vector<double>& p2, double resolution) {
+             const int n = c.world().robot().dimension();
+             return c.check(pose_of(p1, n), pose_of(p2, n), resolution);
+           }, "pose1"_a, "pose2"_a, "resolution"_a = 0.01)
+      .def("check_se2",
+           [](kcplan::EdgeCertifier& c, double x1, double y1, double yaw1, double x2, double y2,
+              double yaw2, double resolution) {
+             require(c.world(), 2);
+             return c.check(se2(x1, y1, yaw1), se2(x2, y2, yaw2), resolution);
+           }, "x1"_a, "y1"_a, "yaw1"_a, "x2"_a, "y2"_a, "yaw2"_a, "resolution"_a = 0.01)
+      .def("check_se3",
+           [](kcplan::EdgeCertifier& c, double x1, double y1, double z1, double a1, double b1,
+              double c1, double d1, double x2, double y2, double z2, double a2, double b2,
+              double c2, double d2, double resolution) {
+             require(c.world(), 3);
+             return c.check(se3(x1, y1, z1, a1, b1, c1, d1), se3(x2, y2, z2, a2, b2, c2, d2),
+                            resolution);
+           })
+      .def("state_valid",
+           [](kcplan::EdgeCertifier& c, const std::vector<double>& p) {
+             return c.state_valid(pose_of(p, c.world().robot().dimension()));
+           }, "pose"_a)
+      .def("state_valid_se2",
+           [](kcplan::EdgeCertifier& c, double x, double y, double yaw) {
+             require(c.world(), 2);
+             return c.state_valid(se2(x, y, yaw));
+           })
+      .def("state_valid_se3",
+           [](kcplan::EdgeCertifier& c, double x, double y, double z, double qx, double qy,
+              double qz, double qw) {
+             require(c.world(), 3);
+             return c.state_valid(se3(x, y, z, qx, qy, qz, qw));
+           })
+      .def("measure",
+           [](kcplan::EdgeCertifier& c, const std::vector<double>& p) {
+             const kcplan::Guard g = c.measure(pose_of(p, c.world().robot().dimension()));
+             return nb::make_tuple(g.clearance, guard_bodies(g));
+           }, "pose"_a)
+      .def_prop_ro("counters", [](const kcplan::EdgeCertifier& c) {
+        return certifier_counters(c.counters);
+      })
+      .def_prop_ro("covered", [](const kcplan::EdgeCertifier& c) {
+        nb::dict d;
+        for (std::size_t i = 0; i < c.certificates().size(); ++i)
+          d[c.certificates()[i]->name()] = c.covered()[i];
+        return d;
+      })
+      .def_prop_ro("cache_size", [](const kcplan::EdgeCertifier& c) { return c.cache().size(); })
+      .def_prop_ro("validity_cache_size",
+                   [](const kcplan::EdgeCertifier& c) { return c.cache().validity_size(); })
+      .def_prop_ro("horizon", &kcplan::EdgeCertifier::horizon)
+      .def_prop_ro("margin", &kcplan::EdgeCertifier::margin)
+      .def_prop_ro("sweep_test", &kcplan::EdgeCertifier::sweep_test)
+      .def_prop_ro("occupancy", &kcplan::EdgeCertifier::occupancy)
+      .def_prop_ro("discrete", &kcplan::EdgeCertifier::discrete);
+}

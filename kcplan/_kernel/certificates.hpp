@@ -1,0 +1,149 @@
+// Edge certificates: sound rules that prove a stretch of an edge free from one guard.
+// Python twin: kcplan/planning/certificates/ (ball.py, region.py, polytope.py); the proofs
+// are in those modules' docstrings, the rules here are the same, line for line.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "guard.hpp"
+#include "pose.hpp"
+#include "robot.hpp"
+
+namespace kcplan {
+
+/// A certificate reads a guard measured at the edge's pose q(m) and proves every pose q(s)
+/// with m - minus <= s <= m + plus collision-free. It never queries the world; what it
+/// cannot prove it reports as (0, 0). Several certificates' proofs from one guard form an
+/// interval around m, so the certifier takes the largest reach on each side.
+class Certificate {
+ public:
+  virtual ~Certificate() = default;
+  virtual const char* name() const = 0;
+  virtual void reach(const Guard& guard, const Edge& edge, double m, double& minus,
+                     double& plus) const = 0;
+};
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Conservative advancement with a clearance ball per body: body k stays free while
+/// |s - m| (|dt| + L_k |w|) <= d_k, with the lever L_k = |p_k| + a_max - a_min ("rotation")
+/// or the reach |p_k| + a_max ("ball").
+class ClearanceBall final : public Certificate {
+ public:
+  ClearanceBall(const Robot& robot, bool rotation_aware) : rotation_aware_(rotation_aware) {
+    for (const Body& b : robot.bodies()) levers_.push_back(rotation_aware ? b.lever() : b.reach());
+  }
+  const char* name() const override { return rotation_aware_ ? "rotation" : "ball"; }
+  void reach(const Guard& guard, const Edge& edge, double, double& minus,
+             double& plus) const override {
+    double r = kInf;
+    const double v = edge.translation_speed(), w = edge.rotation_speed();
+    for (std::size_t k = 0; k < levers_.size(); ++k) {
+      const double speed = v + levers_[k] * w;
+      if (speed > 0.0) r = std::min(r, guard.bodies[k].clearance / speed);
+    }
+    minus = plus = r;
+  }
+
+ private:
+  bool rotation_aware_;
+  std::vector<double> levers_;
+};
+
+/// Separating planes of every piece within each body's horizon: piece i stays on its side
+/// while sigma_i + (s - m) n_i . dt - |s - m| L_k |w| > 0, or within its clearance ball;
+/// pieces beyond the horizon are covered by the ball of radius `horizon`.
+class FreeRegionPlanes final : public Certificate {
+ public:
+  explicit FreeRegionPlanes(const Robot& robot) {
+    for (const Body& b : robot.bodies()) levers_.push_back(b.lever());
+  }
+  const char* name() const override { return "region"; }
+  void reach(const Guard& guard, const Edge& edge, double, double& minus,
+             double& plus) const override {
+    minus = plus = kInf;
+    const double v = edge.translation_speed(), w = edge.rotation_speed();
+    const std::array<double, 3>& dt = edge.dt();
+    for (std::size_t k = 0; k < levers_.size(); ++k) {
+      const BodyGuard& body = guard.bodies[k];
+      const double turn = levers_[k] * w, speed = v + turn;
+      if (speed <= 0.0) continue;
+      const double horizon = body.horizon / speed;
+      plus = std::min(plus, horizon), minus = std::min(minus, horizon);
+      for (const PlaneRow& p : body.planes) {
+        const double ball = p.clearance / speed;
+        if (p.slack > 0.0) {
+          const double along = p.nx * dt[0] + p.ny * dt[1] + p.nz * dt[2];
+          double rate = turn - along;  // slack used up per unit s going forward
+          const double ahead = rate > 0.0 ? p.slack / rate : kInf;
+          rate = turn + along;  // ... going backward
+          const double behind = rate > 0.0 ? p.slack / rate : kInf;
+          plus = std::min(plus, std::max(ahead, ball));
+          minus = std::min(minus, std::max(behind, ball));
+        } else {
+          plus = std::min(plus, ball), minus = std::min(minus, ball);
+        }
+      }
+    }
+  }
+
+ private:
+  std::vector<double> levers_;
+};
+
+/// The paper's convex lower bound P_eps of the largest free guard (1 + eps) E_a on a
+/// ladder: eps <= clearance / max(a); the guard covers the gauge of P_eps along the
+/// edge's KC direction on each side. The rows are A_i / c_i of each level's polytope,
+/// built and proven sound in Python (kcplan/kc/convex.py, cached by planning/ladder.py).
+class KCPolytope final : public Certificate {
+ public:
+  /// `levels` increasing inflations; `rows[l]` the scaled rows of level l, flat
+  /// (count x width, width 3 in 2D and 6 in 3D); `scale` = max(a).
+  KCPolytope(std::vector<double> levels, std::vector<std::vector<double>> rows, int width,
+             double scale)
+      : levels_(std::move(levels)), rows_(std::move(rows)), width_(width), scale_(scale) {
+    if (levels_.size() != rows_.size() || levels_.empty() || (width != 3 && width != 6) ||
+        !(scale > 0.0))
+      throw std::invalid_argument("ladder: expected one row block per level, width 3 or 6");
+    for (std::size_t l = 0; l < levels_.size(); ++l)
+      if (rows_[l].empty() || rows_[l].size() % width ||
+          (l && !(levels_[l] > levels_[l - 1])))
+        throw std::invalid_argument("ladder: levels must increase and rows be count x width");
+  }
+  const char* name() const override { return "polytope"; }
+  void reach(const Guard& guard, const Edge& edge, double m, double& minus,
+             double& plus) const override {
+    // the largest level with eps <= clearance / scale (Python's bisect_right - 1)
+    const double e = guard.clearance / scale_;
+    const int level = static_cast<int>(std::upper_bound(levels_.begin(), levels_.end(), e) -
+                                       levels_.begin()) - 1;
+    if (level < 0) {
+      minus = plus = 0.0;
+      return;
+    }
+    double d[6];
+    edge.direction(m, d);
+    const std::vector<double>& A = rows_[level];
+    double top = -kInf, bottom = kInf;
+    for (std::size_t i = 0; i < A.size(); i += width_) {
+      double p = 0.0;
+      for (int j = 0; j < width_; ++j) p += A[i + j] * d[j];
+      top = std::max(top, p), bottom = std::min(bottom, p);
+    }
+    plus = top > 0.0 ? 1.0 / top : kInf;
+    minus = bottom < 0.0 ? -1.0 / bottom : kInf;
+  }
+
+ private:
+  std::vector<double> levels_;
+  std::vector<std::vector<double>> rows_;
+  int width_;
+  double scale_;
+};
+
+}  // namespace kcplan

@@ -1,0 +1,209 @@
+#include "certifier.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace kcplan {
+
+EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
+                             std::unique_ptr<KCPolytope> polytope)
+    : world_(world), robot_(world.robot()), discrete_(options.discrete),
+      max_guards_(options.max_guards), core_radius_(world.robot().core_radius()),
+      cache_(options.cache_entries) {
+  if (options.certificates.empty())
+    throw std::invalid_argument("certificates: expected names from ball, rotation, polytope, region");
+  for (const std::string& name : options.certificates) {
+    if (name == "ball" || name == "rotation") {
+      certificates_.push_back(std::make_unique<ClearanceBall>(robot_, name == "rotation"));
+    } else if (name == "region") {
+      certificates_.push_back(std::make_unique<FreeRegionPlanes>(robot_));
+      use_region_ = true;
+    } else if (name == "polytope") {
+      if (!robot_.is_single())
+        throw std::invalid_argument(
+            "certificates: 'polytope' (the paper's bound) needs one body centred at the "
+            "robot's origin");
+      if (!polytope) throw std::invalid_argument("certificates: 'polytope' needs a ladder");
+      certificates_.push_back(std::move(polytope));
+    } else {
+      throw std::invalid_argument("certificates: expected names from ball, rotation, polytope, "
+                                  "region, got '" + name + "'");
+    }
+  }
+  if (max_guards_ < 0) throw std::invalid_argument("max_guards: expected a number >= 0");
+  covered_.assign(certificates_.size(), 0.0);
+  horizon_ = options.horizon < 0.0 ? robot_.largest_semi_axis() : options.horizon;
+  margin_ = world.atol() + 1e-12 * robot_.reach();
+  const bool core = core_radius_ > 0.0;
+  sweep_test_ = core && options.sweep_test;
+  if (core && options.occupancy) grid_.emplace(world, options.low, options.high, core_radius_);
+  clearances_.resize(robot_.size());
+}
+
+Guard EdgeCertifier::measure(const Pose& pose) {
+  ++counters.guards;
+  if (use_region_) {
+    world_.free_regions(pose, horizon_, regions_);
+    return Guard::from_regions(pose, regions_, robot_, margin_);
+  }
+  world_.safe_body_clearances(pose, clearances_.data());
+  return Guard::of_clearances(clearances_.data(), clearances_.size());
+}
+
+bool EdgeCertifier::state_valid(const Pose& pose) {
+  if (!pose.finite) return false;
+  const GuardCache::Key key = GuardCache::key(pose);
+  const int known = cache_.validity(key);
+  if (known >= 0) return known == 1;
+  if (grid_ && grid_->blocked(pose.t)) {
+    ++counters.occupancy_rejections;
+    cache_.add_validity(key, false);
+    return false;
+  }
+  return collision_free(pose, key);
+}
+
+bool EdgeCertifier::collision_free(const Pose& p, const GuardCache::Key& key) {
+  ++counters.collision_queries;
+  const bool valid = !world_.in_collision(p);
+  if (!valid && grid_) {  // learn the cell for the next state there
+    const std::int64_t before = grid_->queries;
+    grid_->learn(p.t);
+    counters.occupancy_queries += grid_->queries - before;
+  }
+  cache_.add_validity(key, valid);
+  return valid;
+}
+
+std::shared_ptr<const Guard> EdgeCertifier::endpoint(const Pose& pose,
+                                                     const GuardCache::Key& key) {
+  if (auto g = cache_.guard(key)) return g;
+  ++counters.endpoint_guards;
+  return cache_.add_guard(key, measure(pose));
+}
+
+void EdgeCertifier::reach(const Guard& guard, const Edge& edge, double m, double s0, double s1,
+                          double& lo, double& hi) {
+  double best_minus = 0.0, best_plus = 0.0;
+  int win_minus = -1, win_plus = -1;
+  const double need_minus = m - s0, need_plus = s1 - m;
+  for (std::size_t i = 0; i < certificates_.size(); ++i) {
+    double minus, plus;
+    certificates_[i]->reach(guard, edge, m, minus, plus);
+    if (minus > best_minus) best_minus = minus, win_minus = static_cast<int>(i);
+    if (plus > best_plus) best_plus = plus, win_plus = static_cast<int>(i);
+    if (best_minus >= need_minus && best_plus >= need_plus) break;  // later ones cannot add
+  }
+  lo = m - best_minus, hi = m + best_plus;
+  if (win_minus >= 0 && m > s0) covered_[win_minus] += m - std::max(lo, s0);
+  if (win_plus >= 0 && m < s1) covered_[win_plus] += std::min(hi, s1) - m;
+}
+
+bool EdgeCertifier::reject(std::int64_t& reason) {
+  ++counters.rejected;
+  ++reason;
+  return false;
+}
+
+bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
+  CertifierCounters& c = counters;
+  ++c.edges;
+  if (!p1.finite || !p2.finite) return reject(c.rejected_end_state);  // never free
+  if (p1.size != p2.size || p1.size != pose_size(robot_.dimension()))
+    throw std::invalid_argument("pose: expected " + std::to_string(pose_size(robot_.dimension())) +
+                                " numbers per pose");
+  const GuardCache::Key k1 = GuardCache::key(p1), k2 = GuardCache::key(p2);
+  CoreOccupancy* grid = grid_ ? &*grid_ : nullptr;
+  if (grid && grid->blocked(p2.t)) return reject(c.rejected_occupancy);
+  std::shared_ptr<const Guard> g1 = cache_.guard(k1), g2 = cache_.guard(k2);
+  const bool had_g2 = g2 != nullptr;
+  const int known = cache_.validity(k2);
+  // a state never seen (RRT's new states): the free grid test before any query;
+  // a known state (PRM's milestones): the cached guards first, they often suffice
+  const bool tested = known < 0 && grid;
+  if (tested && grid->segment_blocked(p1.t, p2.t)) return reject(c.rejected_occupancy);
+  if (!(known == 1 || (known < 0 && collision_free(p2, k2)))) return reject(c.rejected_end_state);
+  const Edge edge(p1, p2);
+  double lo = 0.0, hi = 1.0, a, b;
+  if (g1) {
+    ++c.cached_guards;
+    reach(*g1, edge, 0.0, 0.0, 1.0, a, lo);
+  }
+  if (g2 && lo < 1.0) {
+    ++c.cached_guards;
+    reach(*g2, edge, 1.0, lo, 1.0, hi, b);
+  }
+  if (lo >= hi) {
+    ++c.certified_by_endpoints;
+    return true;
+  }
+  if (!tested && grid && grid->segment_blocked(p1.t, p2.t)) return reject(c.rejected_occupancy);
+  if (sweep_test_) {
+    ++c.collision_queries;
+    if (world_.sweep_core_collides(edge.pose(lo).t, edge.pose(hi).t, core_radius_))
+      return reject(c.rejected_sweep);
+  }
+  if (!g1) {
+    g1 = endpoint(p1, k1);
+    if (g1->clearance <= 0.0) return reject(c.rejected_guard);
+    reach(*g1, edge, 0.0, 0.0, hi, a, lo);
+  }
+  if (lo < hi && !had_g2) {
+    g2 = endpoint(p2, k2);
+    if (g2->clearance <= 0.0) return reject(c.rejected_end_state);
+    reach(*g2, edge, 1.0, lo, 1.0, hi, b);
+  }
+  if (lo >= hi) {
+    ++c.certified_by_endpoints;
+    return true;
+  }
+  if (discrete_) return sample(edge, resolution, lo, hi);
+  return advance(edge, lo, hi);
+}
+
+bool EdgeCertifier::advance(const Edge& edge, double lo, double hi) {
+  CertifierCounters& c = counters;
+  pending_.clear();
+  pending_.emplace_back(lo, hi);
+  int guards = 0;
+  while (!pending_.empty()) {
+    const auto [s0, s1] = pending_.back();
+    pending_.pop_back();
+    if (guards >= max_guards_) {
+      c.bisection_nodes += guards;
+      return reject(c.not_proven);
+    }
+    const double m = 0.5 * (s0 + s1);
+    const Guard guard = measure(edge.pose(m));
+    ++guards;
+    if (guard.clearance <= 0.0) {
+      c.bisection_nodes += guards;
+      return reject(c.rejected_guard);
+    }
+    double g_lo, g_hi;
+    reach(guard, edge, m, s0, s1, g_lo, g_hi);
+    if (g_hi - g_lo <= 1e-12) {
+      c.bisection_nodes += guards;
+      return reject(c.not_proven);
+    }
+    if (g_lo > s0) pending_.emplace_back(s0, g_lo);
+    if (g_hi < s1) pending_.emplace_back(g_hi, s1);
+  }
+  c.bisection_nodes += guards;
+  c.certified_one_guard += guards == 1;
+  return true;
+}
+
+bool EdgeCertifier::sample(const Edge& edge, double resolution, double lo, double hi) {
+  if (!(resolution > 0.0)) throw std::invalid_argument("resolution: expected a positive number");
+  const int steps = std::max(1, static_cast<int>(std::ceil(1.0 / resolution)));
+  for (int i = 1; i < steps; ++i) {
+    const double s = double(i) / steps;
+    if (s <= lo || s >= hi) continue;  // covered by an endpoint guard
+    ++counters.collision_queries;
+    if (world_.in_collision(edge.pose(s))) return reject(counters.rejected_guard);
+  }
+  return true;
+}
+
+}  // namespace kcplan

@@ -1,0 +1,102 @@
+// The edge certifier: where certificates, guards, the guard cache and rejection meet.
+// Python twin: kcplan/planning/certifier.py (EdgeCertifier); both decide every edge by the
+// same steps and count them under the same names (COUNTER_NAMES).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "certificates.hpp"
+#include "guard.hpp"
+#include "occupancy.hpp"
+#include "pose.hpp"
+#include "world.hpp"
+
+namespace kcplan {
+
+/// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
+struct CertifierCounters {
+  std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
+               rejected_occupancy = 0, rejected_guard = 0, not_proven = 0,
+               certified_by_endpoints = 0, certified_one_guard = 0, guards = 0,
+               endpoint_guards = 0, cached_guards = 0, bisection_nodes = 0,
+               collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0;
+};
+
+/// Options of an EdgeCertifier; the defaults are the Python certifier's.
+struct CertifierOptions {
+  std::vector<std::string> certificates{"region"};  ///< ball, rotation, polytope, region
+  bool discrete = false;     ///< fallback: OMPL-style sampling instead of advancement
+  int max_guards = 64;       ///< guards per edge after the endpoints before "not proven"
+  double horizon = -1.0;     ///< region horizon; < 0: the largest semi-axis
+  bool sweep_test = true;    ///< the core-capsule rejection (needs a core)
+  bool occupancy = true;     ///< the occupancy grid (needs a core)
+  std::array<double, 3> low{0, 0, 0}, high{0, 0, 0};  ///< bounds of the robot's origin
+  std::size_t cache_entries = 200000;
+};
+
+/// Prove OMPL edges collision-free with guards and certificates, or reject them.
+///
+/// `check(p1, p2)` follows OMPL's MotionValidator contract: p1 is assumed valid, p2 is
+/// not. It returns true only when the whole edge, interpolated as OMPL does, is proven
+/// free: (1) p2 is rejected by the occupancy grid or one collision query unless the cache
+/// knows it; (2) cached endpoint guards may certify it with no query; (3) a centre path
+/// through a blocked cell or a colliding core capsule rejects it; (4) missing endpoint
+/// guards are measured and cached; (5) advancement places guards in the middle of what is
+/// left open until nothing is (certified), one touches an obstacle or makes no progress
+/// (rejected), or max_guards were placed ("not proven": rejected). A pose that is not
+/// finite is never free. Not thread-safe (the world's coal objects are reused).
+class EdgeCertifier {
+ public:
+  EdgeCertifier(World& world, const CertifierOptions& options,
+                std::unique_ptr<KCPolytope> polytope = nullptr);
+  EdgeCertifier(const EdgeCertifier&) = delete;
+  EdgeCertifier& operator=(const EdgeCertifier&) = delete;
+
+  /// Whether the whole edge p1 -> p2 is proven free; `resolution` (in units of s) is the
+  /// step of the discrete fallback.
+  bool check(const Pose& p1, const Pose& p2, double resolution = 0.01);
+  /// State validity with the cache: one collision query for a pose not seen before.
+  bool state_valid(const Pose& pose);
+  /// One guard query at `pose`, not cached.
+  Guard measure(const Pose& pose);
+
+  const std::vector<std::unique_ptr<Certificate>>& certificates() const { return certificates_; }
+  const std::vector<double>& covered() const { return covered_; }
+  const GuardCache& cache() const { return cache_; }
+  double horizon() const { return horizon_; }
+  double margin() const { return margin_; }
+  bool sweep_test() const { return sweep_test_; }
+  bool occupancy() const { return grid_.has_value(); }
+  bool discrete() const { return discrete_; }
+  World& world() { return world_; }
+  CertifierCounters counters;
+
+ private:
+  bool collision_free(const Pose& p, const GuardCache::Key& key);
+  std::shared_ptr<const Guard> endpoint(const Pose& pose, const GuardCache::Key& key);
+  void reach(const Guard& guard, const Edge& edge, double m, double s0, double s1, double& lo,
+             double& hi);
+  bool reject(std::int64_t& reason);
+  bool advance(const Edge& edge, double lo, double hi);
+  bool sample(const Edge& edge, double resolution, double lo, double hi);
+
+  World& world_;
+  const Robot& robot_;
+  std::vector<std::unique_ptr<Certificate>> certificates_;
+  std::vector<double> covered_;
+  bool use_region_ = false, discrete_ = false, sweep_test_ = false;
+  int max_guards_;
+  double horizon_, margin_, core_radius_;
+  GuardCache cache_;
+  std::optional<CoreOccupancy> grid_;
+  std::vector<FreeRegion> regions_;  // scratch of region queries
+  std::vector<double> clearances_;   // scratch of clearance queries
+  std::vector<std::pair<double, double>> pending_;
+};
+
+}  // namespace kcplan

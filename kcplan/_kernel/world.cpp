@@ -1,0 +1,428 @@
+#include "world.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <coal/BVH/BVH_model.h>
+#include <coal/broadphase/default_broadphase_callbacks.h>
+#include <coal/collision.h>
+#include <coal/distance.h>
+#include <coal/shape/convex.h>
+#include <coal/shape/geometric_shapes.h>
+
+namespace kcplan {
+namespace {
+
+using coal::Vec3s;
+
+coal::Matrix3s matrix(const Quat& q) {
+  return Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+}
+
+coal::Matrix3s matrix(const std::array<double, 9>& r) {
+  coal::Matrix3s m;
+  m << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+  return m;
+}
+
+void require_finite(const Pose& pose) {
+  if (!pose.finite)
+    throw std::invalid_argument("pose: expected finite numbers (and a non-zero quaternion)");
+}
+
+void require_finite(const double* v, std::size_t n, const char* what) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(v[i]))
+      throw std::invalid_argument(std::string(what) + ": expected finite numbers");
+}
+
+/// A convex polytope with its triangles: coal fills the vertex neighbours from them.
+std::shared_ptr<coal::CollisionGeometry> convex(const std::vector<Vec3s>& points,
+                                                const std::vector<int>& triangles) {
+  const std::size_t m = points.size(), t = triangles.size() / 3;
+  if (m < 4 || t < 4 || triangles.size() != 3 * t)
+    throw std::invalid_argument("convex: expected at least 4 vertices and 4 triangles");
+  auto vertices = std::make_shared<std::vector<Vec3s>>(points);
+  auto faces = std::make_shared<std::vector<coal::Triangle>>();
+  faces->reserve(t);
+  for (std::size_t i = 0; i < t; ++i) {
+    for (int j = 0; j < 3; ++j)
+      if (triangles[3 * i + j] < 0 || static_cast<std::size_t>(triangles[3 * i + j]) >= m)
+        throw std::invalid_argument("convex: triangle index out of range");
+    faces->emplace_back(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
+  }
+  auto shape = std::make_shared<coal::Convex<coal::Triangle>>(
+      vertices, static_cast<unsigned int>(m), faces, static_cast<unsigned int>(t));
+  shape->computeLocalAABB();
+  return shape;
+}
+
+/// Collects the obstacles whose bounding boxes meet the query object's (no narrow phase).
+struct Collect : coal::CollisionCallBackBase {
+  coal::CollisionObject* query = nullptr;
+  std::vector<coal::CollisionObject*>* found = nullptr;
+  bool collide(coal::CollisionObject* o1, coal::CollisionObject* o2) override {
+    found->push_back(o1 == query ? o2 : o1);
+    return false;  // keep going: every piece in the box
+  }
+};
+
+}  // namespace
+
+double World::Support::operator()(const double* n) const {
+  switch (kind) {
+    case kPoints: {
+      double best = -std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < points.size(); i += 3)
+        best = std::max(best, points[i] * n[0] + points[i + 1] * n[1] + points[i + 2] * n[2]);
+      return best;
+    }
+    case kBall:
+      return centre[0] * n[0] + centre[1] * n[1] + centre[2] * n[2] +
+             radius * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    case kEllipsoid: {
+      double sq = 0.0;
+      for (int r = 0; r < 3; ++r) {
+        const double v = shape[3 * r] * n[0] + shape[3 * r + 1] * n[1] + shape[3 * r + 2] * n[2];
+        sq += v * v;
+      }
+      return centre[0] * n[0] + centre[1] * n[1] + centre[2] * n[2] + std::sqrt(sq);
+    }
+    case kNone:
+      break;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+World::World(const Robot& robot, double half_height, double rtol, double atol)
+    : robot_(robot), dimension_(robot.dimension()), half_height_(half_height), rtol_(rtol),
+      atol_(atol) {
+  if (!(half_height > 0.0) || !(rtol >= 0.0 && rtol < 1.0) || !(atol >= 0.0) ||
+      !std::isfinite(half_height) || !std::isfinite(atol))
+    throw std::invalid_argument(
+        "world: expected half_height > 0, 0 <= rtol < 1 and a finite atol >= 0");
+  for (const Body& b : robot.bodies()) {
+    const double c = dimension_ == 2 ? b.a_min : b.semi_axes[2];
+    auto shape = std::make_shared<coal::Ellipsoid>(b.semi_axes[0], b.semi_axes[1], c);
+    bodies_.push_back(std::make_unique<coal::CollisionObject>(shape));
+    horizon_boxes_.emplace_back();
+    horizon_sides_.push_back(-1.0);
+  }
+  body_query_counts.assign(robot.size(), 0);
+  manager_ = std::make_unique<coal::DynamicAABBTreeCollisionManager>();
+}
+
+void World::add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
+                const coal::Transform3s& transform, Support support) {
+  if (finalized_) throw std::logic_error("world: obstacles must be added before finalize()");
+  auto object = std::make_unique<coal::CollisionObject>(geometry, transform);
+  object->computeAABB();
+  object->setUserData(reinterpret_cast<void*>(supports_.size()));
+  supports_.push_back(std::move(support));
+  objects_.push_back(std::move(object));
+}
+
+void World::add_prism(const std::vector<double>& xy) {
+  const std::size_t k = xy.size() / 2;
+  if (k < 3 || xy.size() != 2 * k)
+    throw std::invalid_argument("prism: expected a polygon of at least 3 points");
+  require_finite(xy.data(), xy.size(), "prism");
+  std::vector<Vec3s> points;
+  Support support;
+  support.kind = Support::kPoints;
+  for (double z : {-half_height_, half_height_})
+    for (std::size_t i = 0; i < k; ++i) points.emplace_back(xy[2 * i], xy[2 * i + 1], z);
+  for (std::size_t i = 0; i < k; ++i) support.points.insert(support.points.end(), {xy[2 * i], xy[2 * i + 1], 0.0});
+  std::vector<int> tri;
+  const int n = static_cast<int>(k);
+  for (int i = 1; i + 1 < n; ++i) {  // caps as fans: bottom (0..k-1), top (k..2k-1)
+    tri.insert(tri.end(), {0, i + 1, i});
+    tri.insert(tri.end(), {n, n + i, n + i + 1});
+  }
+  for (int i = 0; i < n; ++i) {  // sides: two triangles per edge
+    const int j = (i + 1) % n;
+    tri.insert(tri.end(), {i, j, n + j});
+    tri.insert(tri.end(), {i, n + j, n + i});
+  }
+  add(convex(points, tri), coal::Transform3s::Identity(), std::move(support));
+}
+
+void World::add_box(const std::array<double, 3>& centre, const std::array<double, 9>& rotation,
+                    const std::array<double, 3>& half) {
+  require_finite(centre.data(), 3, "box");
+  require_finite(rotation.data(), 9, "box");
+  for (double h : half)
+    if (!(h > 0.0) || !std::isfinite(h))
+      throw std::invalid_argument("box: expected positive finite half sides");
+  const coal::Matrix3s R = matrix(rotation);
+  Support support;
+  support.kind = Support::kPoints;
+  std::vector<Vec3s> corners;
+  for (int c = 0; c < 8; ++c) {  // corner 4i + 2j + k has signs (i, j, k)
+    const Vec3s local((c & 4 ? 1 : -1) * half[0], (c & 2 ? 1 : -1) * half[1],
+                      (c & 1 ? 1 : -1) * half[2]);
+    const Vec3s x = Vec3s(centre[0], centre[1], centre[2]) + R * local;
+    corners.push_back(x);
+    support.points.insert(support.points.end(), {x[0], x[1], x[2]});
+  }
+  if (R.isIdentity(0.0)) {
+    add(std::make_shared<coal::Box>(2 * half[0], 2 * half[1], 2 * half[2]),
+        coal::Transform3s(coal::Matrix3s::Identity(), Vec3s(centre[0], centre[1], centre[2])),
+        std::move(support));
+    return;
+  }
+  static const std::vector<int> faces = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                                         2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+  add(convex(corners, faces), coal::Transform3s::Identity(), std::move(support));
+}
+
+void World::add_convex(const std::vector<double>& vertices, const std::vector<int>& triangles) {
+  if (vertices.size() % 3) throw std::invalid_argument("convex: expected m x 3 vertices");
+  require_finite(vertices.data(), vertices.size(), "convex");
+  std::vector<Vec3s> points;
+  for (std::size_t i = 0; i < vertices.size(); i += 3)
+    points.emplace_back(vertices[i], vertices[i + 1], vertices[i + 2]);
+  Support support;
+  support.kind = Support::kPoints;
+  support.points = vertices;
+  add(convex(points, triangles), coal::Transform3s::Identity(), std::move(support));
+}
+
+void World::add_sphere(const std::array<double, 3>& centre, double radius) {
+  require_finite(centre.data(), 3, "sphere");
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw std::invalid_argument("sphere: expected a positive finite radius");
+  Support support;
+  support.kind = Support::kBall;
+  support.centre = centre;
+  support.radius = radius;
+  add(std::make_shared<coal::Sphere>(radius),
+      coal::Transform3s(coal::Matrix3s::Identity(), Vec3s(centre[0], centre[1], centre[2])),
+      std::move(support));
+}
+
+void World::add_ellipsoid(const std::array<double, 3>& centre,
+                          const std::array<double, 9>& rotation,
+                          const std::array<double, 3>& extents) {
+  require_finite(centre.data(), 3, "ellipsoid");
+  require_finite(rotation.data(), 9, "ellipsoid");
+  for (double e : extents)
+    if (!(e > 0.0) || !std::isfinite(e))
+      throw std::invalid_argument("ellipsoid: expected positive finite semi-axes");
+  Support support;
+  support.kind = Support::kEllipsoid;
+  support.centre = centre;
+  // shape = diag(e) R^T: row r is e_r times column r of R; in 2D the third row is 0 so
+  // that only the planar ellipse counts (its support in the plane is the 2D one)
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      support.shape[3 * r + c] =
+          (dimension_ == 2 && r == 2) ? 0.0 : extents[r] * rotation[3 * c + r];
+  add(std::make_shared<coal::Ellipsoid>(extents[0], extents[1], extents[2]),
+      coal::Transform3s(matrix(rotation), Vec3s(centre[0], centre[1], centre[2])),
+      std::move(support));
+}
+
+void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles) {
+  const std::size_t m = vertices.size() / 3, t = triangles.size() / 3;
+  if (m < 3 || t < 1 || vertices.size() != 3 * m || triangles.size() != 3 * t)
+    throw std::invalid_argument("mesh: expected m x 3 vertices and t x 3 triangles");
+  require_finite(vertices.data(), vertices.size(), "mesh");
+  std::vector<Vec3s> points;
+  std::vector<coal::Triangle> faces;
+  for (std::size_t i = 0; i < m; ++i)
+    points.emplace_back(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]);
+  for (std::size_t i = 0; i < t; ++i) {
+    for (int j = 0; j < 3; ++j)
+      if (triangles[3 * i + j] < 0 || static_cast<std::size_t>(triangles[3 * i + j]) >= m)
+        throw std::invalid_argument("mesh: triangle index out of range");
+    faces.emplace_back(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
+  }
+  auto model = std::make_shared<coal::BVHModel<coal::OBBRSS>>();
+  model->beginModel(static_cast<unsigned int>(t), static_cast<unsigned int>(m));
+  model->addSubModel(points, faces);
+  model->endModel();
+  model->computeLocalAABB();
+  add(model, coal::Transform3s::Identity(), Support{});
+}
+
+void World::finalize() {
+  if (finalized_) return;
+  std::vector<coal::CollisionObject*> raw;
+  raw.reserve(objects_.size());
+  for (auto& o : objects_) raw.push_back(o.get());
+  if (!raw.empty()) {
+    manager_->registerObjects(raw);
+    manager_->setup();
+  }
+  finalized_ = true;
+}
+
+void World::place(const Pose& pose) {
+  require_finite(pose);
+  if (pose.size != pose_size(dimension_))
+    throw std::invalid_argument("pose: expected " + std::to_string(pose_size(dimension_)) +
+                                " numbers in " + std::to_string(dimension_) + "D, got " +
+                                std::to_string(pose.size));
+  if (!finalized_) finalize();
+  std::array<double, 3> c;
+  Quat q;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    robot_.body_pose(pose, k, c, q);
+    bodies_[k]->setTransform(matrix(q), Vec3s(c[0], c[1], c[2]));
+    bodies_[k]->computeAABB();
+  }
+}
+
+void World::count_body(std::size_t k) {
+  ++counters.body_queries;
+  ++body_query_counts[k];
+}
+
+bool World::collides(coal::CollisionObject& object) {
+  coal::CollisionCallBackDefault callback;
+  callback.init();
+  manager_->collide(&object, &callback);
+  return callback.data.result.isCollision();
+}
+
+double World::distance(coal::CollisionObject& object) {
+  coal::DistanceCallBackDefault callback;
+  callback.data.request.enable_nearest_points = false;
+  callback.init();
+  manager_->distance(&object, &callback);
+  return std::max(callback.data.result.min_distance, 0.0);
+}
+
+bool World::in_collision(const Pose& pose) {
+  place(pose);
+  ++counters.collision_queries;
+  if (objects_.empty()) return false;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    count_body(k);
+    if (collides(*bodies_[k])) return true;
+  }
+  return false;
+}
+
+void World::body_distances(const Pose& pose, double* out) {
+  place(pose);
+  ++counters.distance_queries;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    if (objects_.empty()) {
+      out[k] = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    count_body(k);
+    out[k] = distance(*bodies_[k]);
+  }
+}
+
+void World::safe_body_clearances(const Pose& pose, double* out) {
+  body_distances(pose, out);
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    out[k] = std::max(out[k] * (1.0 - rtol_) - atol_, 0.0);
+}
+
+bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out) {
+  place(pose);
+  ++counters.region_queries;
+  out.resize(bodies_.size());
+  for (FreeRegion& r : out) r.planes.clear(), r.horizon = horizon;
+  if (objects_.empty()) {
+    for (FreeRegion& r : out) r.horizon = std::numeric_limits<double>::infinity();
+    return true;
+  }
+  coal::DistanceRequest request(true, true);
+  coal::DistanceResult result;
+  const double keep = 1.0 - rtol_;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    count_body(k);
+    coal::CollisionObject& body = *bodies_[k];
+    // the broad-phase box of body k: contains every point within `horizon` of the body
+    const double side = 2.0 * (robot_.bodies()[k].a_max + horizon);
+    if (horizon_sides_[k] != side) {
+      const double height = dimension_ == 3 ? side : 4.0 * half_height_;  // every prism
+      horizon_boxes_[k] =
+          std::make_unique<coal::CollisionObject>(std::make_shared<coal::Box>(side, side, height));
+      horizon_sides_[k] = side;
+    }
+    coal::CollisionObject& box = *horizon_boxes_[k];
+    box.setTranslation(body.getTranslation());
+    box.computeAABB();
+    near_.clear();
+    Collect collect;
+    collect.query = &box;
+    collect.found = &near_;
+    manager_->collide(&box, &collect);
+    counters.region_pairs += static_cast<std::int64_t>(near_.size());
+    FreeRegion& region = out[k];
+    if (near_.empty()) {  // open space: the clearance to everything is the better horizon
+      ++counters.distance_queries;
+      region.horizon = std::max(horizon, distance(body) * keep - atol_);
+      continue;
+    }
+    for (coal::CollisionObject* obstacle : near_) {
+      result.clear();
+      const double d = coal::distance(&body, obstacle, request, result);
+      if (!(d > 0.0)) {
+        for (FreeRegion& r : out) r.planes.clear(), r.horizon = 0.0;
+        return false;
+      }
+      Plane plane;
+      plane.clearance = std::max(d * keep - atol_, 0.0);
+      const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];
+      double v[3] = {dir[0], dir[1], dimension_ == 3 ? dir[2] : 0.0};
+      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const Support& support =
+          supports_[reinterpret_cast<std::size_t>(obstacle->getUserData())];
+      if (support.kind == Support::kNone || !(length > 0.0) || !std::isfinite(length)) {
+        plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
+        plane.offset = std::numeric_limits<double>::infinity();
+      } else {
+        for (int i = 0; i < 3; ++i) plane.n[i] = v[i] / length;
+        plane.offset = support(plane.n);  // exact: a wrong direction only weakens the plane
+      }
+      region.planes.push_back(plane);
+    }
+  }
+  return true;
+}
+
+bool World::ball_collides(const std::array<double, 3>& centre, double radius) {
+  require_finite(centre.data(), 3, "centre");
+  if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
+  if (!finalized_) finalize();
+  ++counters.collision_queries;
+  if (objects_.empty()) return false;
+  coal::CollisionObject ball(std::make_shared<coal::Sphere>(radius),
+                             coal::Transform3s(coal::Matrix3s::Identity(),
+                                               Vec3s(centre[0], centre[1], centre[2])));
+  ball.computeAABB();
+  return collides(ball);
+}
+
+bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,
+                                double radius) {
+  require_finite(a.data(), 3, "sweep");
+  require_finite(b.data(), 3, "sweep");
+  if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
+  if (!finalized_) finalize();
+  ++counters.collision_queries;
+  if (objects_.empty()) return false;
+  const Vec3s p(a[0], a[1], a[2]), q(b[0], b[1], b[2]);
+  const Vec3s d = q - p;
+  const double length = d.norm();
+  // the rotation taking the capsule's z axis onto the segment
+  const Vec3s u = length > 0.0 ? Vec3s(d / length) : Vec3s(0.0, 0.0, 1.0);
+  const coal::Matrix3s R =
+      Eigen::Quaterniond::FromTwoVectors(Vec3s(0.0, 0.0, 1.0), u).toRotationMatrix();
+  coal::CollisionObject capsule(std::make_shared<coal::Capsule>(radius, length),
+                                coal::Transform3s(R, 0.5 * (p + q)));
+  capsule.computeAABB();
+  return collides(capsule);
+}
+
+}  // namespace kcplan

@@ -1,0 +1,147 @@
+// The collision world on coal: obstacles in one broad phase, the robot's bodies, and the
+// four queries certificates are built from (collision, clearance, free region, core sweep).
+// Python twin: kcplan/world/collision.py (CollisionWorld, on python-fcl).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <coal/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <coal/collision_object.h>
+
+#include "pose.hpp"
+#include "robot.hpp"
+
+namespace kcplan {
+
+/// A separating plane n . x <= offset of one obstacle piece near a body, and the body's
+/// clearance to the piece (never an overestimate). offset = inf: no plane (a mesh, or a
+/// degenerate direction); only the clearance can be used. n has nz = 0 in 2D.
+struct Plane {
+  double n[3];
+  double offset;
+  double clearance;
+};
+
+/// What a region query knows about one body: every piece within `horizon` of it, as a
+/// plane; pieces not listed are at least `horizon` away. Python twin: world/region.py.
+struct FreeRegion {
+  std::vector<Plane> planes;
+  double horizon = 0.0;
+  /// Distance to every obstacle, never an overestimate (0: touching or too close to tell).
+  double clearance() const {
+    double d = horizon;
+    for (const Plane& p : planes) d = std::min(d, p.clearance);
+    return d;
+  }
+};
+
+/// Query counts, with the meanings of CollisionWorld.counters in Python: one per robot pose
+/// queried (`body_queries` one per body actually queried).
+struct WorldCounters {
+  std::int64_t collision_queries = 0, distance_queries = 0, region_queries = 0,
+               region_pairs = 0, body_queries = 0;
+};
+
+/// Collision and clearance queries for one robot against fixed obstacles, on coal.
+///
+/// The plane (2D) is embedded as in the Python world: the robot's bodies are ellipsoids
+/// (a1, a2, min(a)) at z = 0, obstacles are solids whose z = 0 slice and projection are
+/// the planar obstacle (prisms over |z| <= half_height, spheres, ellipsoids
+/// (e1, e2, min(e))), so every 3D answer equals the planar one.
+///
+/// Convex pieces are coal convex polytopes with vertex neighbours (GJK hill-climbs over
+/// them); meshes are BVH surfaces (a body wholly inside a closed mesh is reported free, as
+/// with FCL). Every convex piece keeps its exact support function for region queries.
+///
+/// Contract: obstacles are added, then `finalize()` registers them once; queries take a
+/// robot pose and throw std::invalid_argument for a pose that is not finite. Distances of
+/// `safe_*` queries are reduced by coal's error allowance, `d (1 - rtol) - atol`, and are
+/// never overestimates (the allowance is justified in kcplan/_kernel/__init__.py).
+/// Not thread-safe: the robot's coal objects and the solvers are reused between queries.
+class World {
+ public:
+  World(const Robot& robot, double half_height, double rtol, double atol);
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  // -- obstacles (world frame; lengths in the scenario's unit) --
+  /// 2D: the prism over a convex counter-clockwise polygon `xy` (k points, 2k numbers).
+  void add_prism(const std::vector<double>& xy);
+  /// A box of half sides `half` about `centre`, rotated by the row-major 3x3 `rotation`;
+  /// an identity rotation gives coal's Box, any other a convex polytope of the corners.
+  void add_box(const std::array<double, 3>& centre, const std::array<double, 9>& rotation,
+               const std::array<double, 3>& half);
+  /// A convex polytope: vertices (m x 3, row-major) and its hull's triangles (t x 3).
+  void add_convex(const std::vector<double>& vertices, const std::vector<int>& triangles);
+  /// A ball (2D: a disc, as a sphere at z = 0).
+  void add_sphere(const std::array<double, 3>& centre, double radius);
+  /// An ellipsoid {c + R diag(e) u}; in 2D pass (e1, e2, min(e)) and R embedding the yaw.
+  void add_ellipsoid(const std::array<double, 3>& centre, const std::array<double, 9>& rotation,
+                     const std::array<double, 3>& extents);
+  /// A triangle mesh surface (no support function: its pieces keep only clearances).
+  void add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles);
+  /// Register every obstacle in the broad phase (once, after the last add_*).
+  void finalize();
+
+  // -- queries (each counted once per pose) --
+  /// Whether some body touches or overlaps an obstacle (stops at the first that does).
+  bool in_collision(const Pose& pose);
+  /// Distance of each body to the nearest obstacle (0 on contact, inf with no obstacles),
+  /// as coal computes it: may overestimate by coal's error. `out` has one slot per body.
+  void body_distances(const Pose& pose, double* out);
+  /// body_distances reduced by the error allowance: certain lower bounds.
+  void safe_body_clearances(const Pose& pose, double* out);
+  /// Per body, the planes and clearances of every piece whose bounding box meets the cube
+  /// of half side max(a_k) + horizon about the body's centre (a piece outside is at least
+  /// `horizon` away); a body with no such piece gets one distance query and its clearance
+  /// as horizon. Returns false, with every region empty and of horizon 0, as soon as a
+  /// piece touches a body.
+  bool free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out);
+  /// Whether the ball of `radius` about `centre` (z = 0 in 2D) meets an obstacle.
+  bool ball_collides(const std::array<double, 3>& centre, double radius);
+  /// Whether the capsule of `radius` about the segment a -> b meets an obstacle.
+  bool sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,
+                           double radius);
+
+  const Robot& robot() const { return robot_; }
+  std::size_t n_objects() const { return objects_.size(); }
+  double atol() const { return atol_; }
+  double rtol() const { return rtol_; }
+  WorldCounters counters;
+  std::vector<std::int64_t> body_query_counts;
+
+ private:
+  /// The exact support function h(n) = max over the piece of n . x, for region planes.
+  struct Support {
+    enum Kind { kPoints, kBall, kEllipsoid, kNone } kind = kNone;
+    std::vector<double> points;  // kPoints: m x 3
+    std::array<double, 3> centre{};
+    double radius = 0.0;
+    std::array<double, 9> shape{};  // kEllipsoid: diag(e) R^T, row-major
+    double operator()(const double* n) const;
+  };
+
+  void add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
+           const coal::Transform3s& transform, Support support);
+  void place(const Pose& pose);
+  bool collides(coal::CollisionObject& object);
+  double distance(coal::CollisionObject& object);
+  void count_body(std::size_t k);
+
+  Robot robot_;
+  int dimension_;
+  double half_height_, rtol_, atol_;
+  std::vector<std::unique_ptr<coal::CollisionObject>> objects_;
+  std::vector<Support> supports_;
+  std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
+  std::vector<std::unique_ptr<coal::CollisionObject>> horizon_boxes_;
+  std::vector<double> horizon_sides_;
+  std::unique_ptr<coal::DynamicAABBTreeCollisionManager> manager_;
+  std::vector<coal::CollisionObject*> near_;
+  bool finalized_ = false;
+};
+
+}  // namespace kcplan

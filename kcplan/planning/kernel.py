@@ -1,0 +1,134 @@
+"""The compiled edge certifier behind the Python certifier's interface.
+
+:class:`KernelCertifier` runs :class:`kcplan._kernel.EdgeCertifier` (C++, on coal) on the
+kernel twin of a :class:`kcplan.world.CollisionWorld` and answers exactly what
+:class:`kcplan.planning.certifier.EdgeCertifier` answers: ``check``, ``state_valid``,
+``counters`` and ``covered`` under the same names. It holds no logic of its own; the
+decision is made in ``kcplan/_kernel/certifier.cpp``, whose Python twin is
+:mod:`kcplan.planning.certifier`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from kcplan._kernel import EdgeCertifier as _CompiledCertifier
+from kcplan.planning.certifier import CERTIFICATE_SETS, check_certificates
+from kcplan.planning.ladder import GuardLadder
+
+__all__ = ["KernelCertifier"]
+
+
+class KernelCertifier:
+    """:class:`kcplan.planning.certifier.EdgeCertifier`'s decisions, made in C++.
+
+    Parameters
+    ----------
+    world : kcplan.world.CollisionWorld
+        Its :attr:`~kcplan.world.CollisionWorld.kernel` is used (built on first use); the
+        certifier's queries show in ``world.counters``.
+    certificates, ladder, horizon, fallback, max_guards, sweep_test, occupancy
+        As for :class:`~kcplan.planning.certifier.EdgeCertifier` (``sweep_test`` and
+        ``occupancy`` default to on; both need a robot core).
+    cache_entries : int
+        Bound of the guard cache (guards, and as many validity marks).
+
+    Notes
+    -----
+    Not thread-safe: use one world and certifier per thread.
+    """
+
+    backend = "kernel"
+
+    def __init__(
+        self,
+        world,
+        certificates: Sequence[str] | None = None,
+        ladder: GuardLadder | None = None,
+        horizon: float | None = None,
+        fallback: str = "bisection",
+        max_guards: int = 64,
+        sweep_test: bool | None = None,
+        occupancy: bool | None = None,
+        cache_entries: int = 200_000,
+    ):
+        robot = world.robot
+        certificates = tuple(CERTIFICATE_SETS["kc"] if certificates is None else certificates)
+        check_certificates(certificates, robot, regions=True, fallback=fallback)
+        levels, rows, scale = [], [], 1.0
+        if "polytope" in certificates:
+            ladder = ladder or GuardLadder(robot.semi_axes)
+            levels = ladder.inflations.tolist()
+            rows = [block.ravel().tolist() for block in ladder.scaled_rows]
+            scale = ladder.scale
+        low, high = (np.asarray(b, dtype=float).tolist() for b in world.scenario.bounds)
+        pad = [0.0] * (3 - robot.dimension)
+        self.world, self.robot, self.n = world, robot, robot.dimension
+        self.fallback = fallback
+        self.certificates = certificates
+        self._ladder = ladder
+        self._kernel = _CompiledCertifier(
+            world.kernel,
+            list(certificates),
+            fallback == "discrete",
+            int(max_guards),
+            -1.0 if horizon is None else float(horizon),
+            True if sweep_test is None else bool(sweep_test),
+            True if occupancy is None else bool(occupancy),
+            low + pad,
+            high + pad,
+            int(cache_entries),
+            levels,
+            rows,
+            float(scale),
+        )
+        self.horizon = self._kernel.horizon
+        self.margin = self._kernel.margin
+        self.sweep_test = self._kernel.sweep_test
+        self.occupancy = self._kernel.occupancy
+        # the validator's hot path calls these directly (one Python call per edge)
+        self.check_se2, self.check_se3 = self._kernel.check_se2, self._kernel.check_se3
+        self.state_valid_se2 = self._kernel.state_valid_se2
+        self.state_valid_se3 = self._kernel.state_valid_se3
+
+    @property
+    def ladder(self) -> GuardLadder | None:
+        """The polytope ladder, when the ``polytope`` certificate is on."""
+        return self._ladder
+
+    @property
+    def counters(self) -> dict[str, int]:
+        """:data:`kcplan.planning.certifier.COUNTER_NAMES`, counted in C++."""
+        return self._kernel.counters
+
+    @property
+    def covered(self) -> dict[str, float]:
+        """Edge parameter each certificate covered (as the Python certifier's)."""
+        return self._kernel.covered
+
+    @property
+    def cache_size(self) -> int:
+        """Guards in the cache (bounded by ``cache_entries``)."""
+        return self._kernel.cache_size
+
+    def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
+        """True when the whole edge ``pose1 -> pose2`` is proven free."""
+        return self._kernel.check(_flat(pose1), _flat(pose2), float(resolution))
+
+    def state_valid(self, pose: ArrayLike) -> bool:
+        """State validity with the cache (one collision query for a pose not seen before)."""
+        return self._kernel.state_valid(_flat(pose))
+
+    def measure(self, pose: ArrayLike) -> tuple[float, list]:
+        """One guard query at ``pose`` (not cached): ``(clearance, bodies)`` with, per
+        body, ``(clearance, planes, horizon)`` and planes ``(nx, ny, nz, slack,
+        clearance)`` as in :class:`kcplan.planning.guard.BodyGuard`."""
+        return self._kernel.measure(_flat(pose))
+
+
+def _flat(pose: ArrayLike) -> list[float]:
+    return np.asarray(pose, dtype=float).ravel().tolist()
+
