@@ -273,7 +273,8 @@ def test_region_queries_and_certified_edges_with_meshes():
 
 def test_an_exception_in_the_validator_is_raised_after_solve_not_through_ompl():
     """Through PRM's C++ threads an exception would abort the process: the validator
-    rejects, keeps it, and plan() raises it after solve()."""
+    rejects, keeps it, and plan() raises it after solve() (the Python backend, which
+    calls the world's Python methods)."""
     from pathlib import Path
 
     from kcplan.planning.problem import plan
@@ -286,4 +287,4 @@ def test_an_exception_in_the_validator_is_raised_after_solve_not_through_ompl():
     root = Path(__file__).resolve().parents[1]
     scenario = load_scenario(root / "scenarios" / "2d" / "maze.yaml")
     with pytest.raises(RuntimeError, match="region query failed"):
-        plan(scenario, "kc-prm", 1.0, seed=1, world=BrokenWorld(scenario))
+        plan(scenario, "kc-prm-py", 1.0, seed=1, world=BrokenWorld(scenario))
