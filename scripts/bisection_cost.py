@@ -6,10 +6,13 @@ quarter of it), counts the FCL queries the KC certifier spends on each edge it c
 (one collision query for the end state, one distance query per guard) and the queries
 OMPL's discrete validator spends on the same edge (one per state at 1 % resolution,
 ``validSegmentCount``), and relates both to the edge's minimum clearance (gap-free
-verification), in units of the robot's largest semi-axis::
+verification), in units of the robot's largest semi-axis. ``--backend kernel`` (the
+default) certifies with the compiled :class:`kcplan.planning.kernel.KernelCertifier`,
+``python`` with :class:`kcplan.planning.certifier.EdgeCertifier` (the same decisions and
+counters)::
 
     python scripts/bisection_cost.py scenarios/2d/narrow_corridor.yaml ... \
-        [--edges 1500] [--plot benchmarks/bisection_cost.png]
+        [--edges 1500] [--plot benchmarks/bisection_cost.png] [--backend kernel]
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import argparse
 import numpy as np
 
 from kcplan.planning.certifier import EdgeCertifier
+from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
 from kcplan.viz import plt, save_figure
@@ -60,10 +64,12 @@ def edges(scenario, count: int, fraction: float, rng: np.random.Generator):
         yield p1, p2, int(space.validSegmentCount(a, c))
 
 
-def measure(path: str, count: int, fraction: float, seed: int) -> dict:
+def measure(path: str, count: int, fraction: float, seed: int, backend: str = "kernel") -> dict:
     scenario = load_scenario(path)
     scale = float(np.max(scenario.semi_axes))
-    certifier = EdgeCertifier(CollisionWorld(scenario))
+    certifier = (KernelCertifier if backend == "kernel" else EdgeCertifier)(
+        CollisionWorld(scenario)
+    )
     check_world = CollisionWorld(scenario)
     rows = []
     for p1, p2, stock in edges(scenario, count, fraction, np.random.default_rng(seed)):
@@ -97,9 +103,15 @@ def main() -> None:
     parser.add_argument("--edges", type=int, default=1500)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--plot", default="benchmarks/bisection_cost.png")
+    parser.add_argument(
+        "--backend",
+        choices=("kernel", "python"),
+        default="kernel",
+        help="who certifies: the compiled kernel (default) or the Python certifier",
+    )
     args = parser.parse_args()
     results = [
-        measure(path, args.edges, fraction, args.seed)
+        measure(path, args.edges, fraction, args.seed, args.backend)
         for path in args.scenarios
         for fraction in (0.2, 0.05)
     ]

@@ -6,7 +6,7 @@ HRM comparison (section 6: HRM's 3D superquadric maps with the rabbit, rabbit2 a
 the 2D superellipse map with the rabbit and the S shape)::
 
     python scripts/import_real_maps.py [--hrm ../shared/data/external/hrm/resources] \
-        [--out build/hrm]
+        [--out build/hrm] [--maps hrm_ellipse_sparse_2d ...]
 """
 
 from __future__ import annotations
@@ -38,10 +38,14 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--hrm", default=str(here.parent / "shared/data/external/hrm/resources"))
     parser.add_argument("--out", default=str(here / "build" / "hrm"))
+    stems = [m[0] for m in MAPS]
+    parser.add_argument(
+        "--maps", nargs="+", default=stems, choices=stems, help="file stems (default: all)"
+    )
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    for stem, name, dim, robot in MAPS:
+    for stem, name, dim, robot in (m for m in MAPS if m[0] in args.maps):
         target = out / f"{stem}.yaml"
         options = ["--map", name, "--dimension", str(dim), "--robot", robot, "-o", str(target)]
         code = kcplan(["import", "hrm", args.hrm, *options])

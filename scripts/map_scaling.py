@@ -8,7 +8,14 @@ certifier (free-region planes) and by the ca certifier (clearance ball), with th
 and FCL queries per edge and the pieces per region query; and the median time of 3
 kc-rrtconnect / rrtconnect runs between a start and a goal 30 apart::
 
-    python scripts/map_scaling.py [--counts 10 100 1000 10000] [--edges 2000]
+    python scripts/map_scaling.py [--counts 10 100 1000 10000] [--edges 2000] \
+        [--runs 3] [--time 20] [--backend kernel]
+
+``--backend kernel`` (the default) certifies with the compiled
+:class:`kcplan.planning.kernel.KernelCertifier` on coal (the world build includes the
+kernel's) and plans with kc-rrtconnect and rrtconnect; ``python`` certifies with
+:class:`kcplan.planning.certifier.EdgeCertifier` on python-fcl and plans with their
+python-fcl twins, kc-rrtconnect-py and rrtconnect-fcl.
 """
 
 from __future__ import annotations
@@ -21,11 +28,16 @@ from pathlib import Path
 import numpy as np
 
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.problem import plan, seed_ompl
 from kcplan.world import CollisionWorld, load_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 DENSITY = 0.01  # boxes per square unit
+PLANNERS = {  # backend -> the certified planner and its stock twin
+    "kernel": ("kc-rrtconnect", "rrtconnect"),
+    "python": ("kc-rrtconnect-py", "rrtconnect-fcl"),
+}
 
 
 def clutter(count: int, rng: np.random.Generator):
@@ -57,7 +69,9 @@ def clutter(count: int, rng: np.random.Generator):
     return parse_scenario(data, check=False)
 
 
-def edge_costs(world, scenario, edges: int, rng: np.random.Generator) -> dict:
+def edge_costs(
+    world, scenario, edges: int, rng: np.random.Generator, backend: str = "kernel"
+) -> dict:
     low, high = (np.asarray(b) for b in scenario.bounds)
     pairs = []
     while len(pairs) < edges:
@@ -70,7 +84,8 @@ def edge_costs(world, scenario, edges: int, rng: np.random.Generator) -> dict:
     out = {}
     for name in ("kc", "ca"):
         world.reset_counters()
-        certifier = EdgeCertifier(world, certificates=CERTIFICATE_SETS[name])
+        make = KernelCertifier if backend == "kernel" else EdgeCertifier
+        certifier = make(world, certificates=CERTIFICATE_SETS[name])
         t0 = time.perf_counter()
         accepted = sum(certifier.check(p1, p2) for p1, p2 in pairs)
         elapsed = time.perf_counter() - t0
@@ -85,13 +100,15 @@ def edge_costs(world, scenario, edges: int, rng: np.random.Generator) -> dict:
     return out
 
 
-def solve_times(scenario, world, runs: int = 3) -> dict:
+def solve_times(
+    scenario, world, runs: int = 3, limit: float = 20.0, backend: str = "kernel"
+) -> dict:
     out = {}
-    for planner in ("kc-rrtconnect", "rrtconnect"):
+    for planner in PLANNERS[backend]:
         times = []
         for _ in range(runs):
-            r = plan(scenario, planner, 20.0, simplify=False, world=world)
-            times.append(r.time if r.solved else 20.0)
+            r = plan(scenario, planner, limit, simplify=False, world=world)
+            times.append(r.time if r.solved else limit)
         out[planner] = statistics.median(times)
     return out
 
@@ -100,7 +117,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--counts", type=int, nargs="+", default=[10, 100, 1000, 10000])
     parser.add_argument("--edges", type=int, default=2000)
+    parser.add_argument("--runs", type=int, default=3, help="planning runs per planner")
+    parser.add_argument("--time", type=float, default=20.0, help="planning time limit [s]")
+    parser.add_argument(
+        "--backend",
+        choices=tuple(PLANNERS),
+        default="kernel",
+        help="who certifies: the compiled kernel (default) or the Python certifier",
+    )
     args = parser.parse_args()
+    certified, stock = PLANNERS[args.backend]
     seed_ompl(1)
     rng = np.random.default_rng(1)
     maps = [(f"clutter {n}", lambda n=n: clutter(n, rng)) for n in args.counts]
@@ -108,23 +134,25 @@ def main() -> None:
     maps.append(("movingai maze-128", lambda: load_scenario(maze)))
     print(
         "| map | FCL objects | world build [s] | kc us/edge | kc queries/edge "
-        "| pieces/region query | ca us/edge | ca queries/edge | kc-rrtconnect [s] "
-        "| rrtconnect [s] |"
+        f"| pieces/region query | ca us/edge | ca queries/edge | {certified} [s] "
+        f"| {stock} [s] |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for label, make in maps:
         scenario = make()
         t0 = time.perf_counter()
         world = CollisionWorld(scenario)
+        if args.backend == "kernel":
+            world.kernel  # noqa: B018 - built on first use: part of the build time
         build = time.perf_counter() - t0
-        costs = edge_costs(world, scenario, args.edges, rng)
-        solve = solve_times(scenario, world)
+        costs = edge_costs(world, scenario, args.edges, rng, args.backend)
+        solve = solve_times(scenario, world, args.runs, args.time, args.backend)
         kc, ca = costs["kc"], costs["ca"]
         print(
             f"| {label} | {world.n_objects} | {build:.2f} | {kc['us_per_edge']:.0f} "
             f"| {kc['queries_per_edge']:.2f} | {kc['pieces_per_region']:.1f} "
             f"| {ca['us_per_edge']:.0f} | {ca['queries_per_edge']:.2f} "
-            f"| {solve['kc-rrtconnect']:.3f} | {solve['rrtconnect']:.3f} |",
+            f"| {solve[certified]:.3f} | {solve[stock]:.3f} |",
             flush=True,
         )
 

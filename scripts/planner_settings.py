@@ -5,7 +5,8 @@ space's maximum extent; OMPL's default is 0.2), and kc-prm and prm with several 
 nearest-neighbour counts (OMPL's default 10), on the same seeds, each run in a fresh
 process (OMPL seeds once per process), and prints medians as a Markdown table::
 
-    python scripts/planner_settings.py scenarios/2d/slanted_gap.yaml ... [--runs 6]
+    python scripts/planner_settings.py scenarios/2d/slanted_gap.yaml ... [--runs 6] \
+        [--ranges 0.025 0.05 0.2] [--neighbors 5 10 20] [--time 10]
 """
 
 from __future__ import annotations
@@ -27,37 +28,47 @@ from kcplan.world import load_scenario
 path, planner, key, value, seed, limit = sys.argv[1:7]
 spec = problem.PLANNERS[planner]
 value = float(value) if key == "range_factor" else int(value)
-problem.PLANNERS["custom"] = dataclasses.replace(spec, **{key: value})
-r = problem.plan(load_scenario(path), "custom", float(limit), int(seed), simplify=False)
+problem.PLANNERS[planner] = dataclasses.replace(spec, **{key: value})
+r = problem.plan(load_scenario(path), planner, float(limit), int(seed), simplify=False)
 print(json.dumps([r.solved, r.time, r.counters["fcl_queries"]]))
 """
 
 
-def run(path: str, planner: str, key: str, value: float, seed: int) -> tuple[bool, float, int]:
-    out = subprocess.run(
-        [sys.executable, "-c", _RUN, path, planner, key, str(value), str(seed), str(TIME_LIMIT)],
+def run(
+    path: str, planner: str, key: str, value: float, seed: int, limit: float = TIME_LIMIT
+) -> tuple[bool, float, int]:
+    proc = subprocess.run(
+        [sys.executable, "-c", _RUN, path, planner, key, str(value), str(seed), str(limit)],
         capture_output=True,
         text=True,
-        check=True,
-    ).stdout
-    solved, t, q = json.loads(out.strip().splitlines()[-1])
-    return solved, (t if solved else TIME_LIMIT), q
+    )
+    if proc.returncode:
+        sys.exit(f"{planner} with {key} = {value}, seed {seed} failed:\n{proc.stderr}")
+    solved, t, q = json.loads(proc.stdout.strip().splitlines()[-1])
+    return solved, (t if solved else limit), q
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="+")
     parser.add_argument("--runs", type=int, default=6)
+    parser.add_argument(
+        "--ranges", type=float, nargs="+", default=list(RANGES), help="fractions of the extent"
+    )
+    parser.add_argument("--neighbors", type=int, nargs="+", default=list(NEIGHBORS))
+    parser.add_argument("--time", type=float, default=TIME_LIMIT, help="time limit [s]")
     args = parser.parse_args()
     print("| scenario | planner | setting | solved | median time [s] | median FCL queries |")
     print("|---|---|---|---|---|---|")
     rrts = ("kc-rrtconnect", "ca-rrtconnect", "rrtconnect")
-    grid = [(p, "range_factor", v) for p in rrts for v in RANGES]
-    grid += [(p, "neighbors", v) for p in ("kc-prm", "prm") for v in NEIGHBORS]
+    grid = [(p, "range_factor", v) for p in rrts for v in args.ranges]
+    grid += [(p, "neighbors", v) for p in ("kc-prm", "prm") for v in args.neighbors]
     for path in args.scenarios:
         name = path.rsplit("/", 1)[-1].removesuffix(".yaml")
         for planner, key, value in grid:
-            runs = [run(path, planner, key, value, seed) for seed in range(1, args.runs + 1)]
+            runs = [
+                run(path, planner, key, value, seed, args.time) for seed in range(1, args.runs + 1)
+            ]
             label = f"range {value:g}" if key == "range_factor" else f"k = {value}"
             print(
                 f"| {name} | {planner} | {label} | {sum(r[0] for r in runs)}/{len(runs)} "

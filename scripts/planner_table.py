@@ -6,7 +6,12 @@ run on to the limit; AORRTC, which ignores that stop, is timed by its recorded f
 solution, ``PlanResult.first_solution_time``); every path is verified without gaps.
 Prints a markdown table::
 
-    python scripts/planner_table.py [--runs 3] [--time 5] [--jobs 2]
+    python scripts/planner_table.py [--runs 3] [--time 5] [--jobs 2] \
+        [--maps scenarios/2d/random_clutter.yaml scenarios/3d/box_field.yaml] \
+        [--planners rrtconnect prm ...]
+
+``--planners`` names stock planners, each run with its kc twin (default: RRT-Connect, PRM
+and every planner of :data:`kcplan.planning.names.CERTIFIABLE`).
 """
 
 from __future__ import annotations
@@ -38,18 +43,21 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--time", type=float, default=5.0)
     parser.add_argument("--jobs", type=int, default=2)
-    args = parser.parse_args()
+    parser.add_argument("--maps", nargs="+", default=list(MAPS), help="scenarios (from the root)")
     bases = ("rrtconnect", "prm", *CERTIFIABLE)
-    planners = [p for base in bases for p in (f"kc-{base}", base)]
-    jobs = [(m, p, 1 + i, args.time) for m in MAPS for p in planners for i in range(args.runs)]
+    parser.add_argument("--planners", nargs="+", default=list(bases), choices=bases)
+    args = parser.parse_args()
+    maps = args.maps
+    planners = [p for base in args.planners for p in (f"kc-{base}", base)]
+    jobs = [(m, p, 1 + i, args.time) for m in maps for p in planners for i in range(args.runs)]
     with mp.get_context("spawn").Pool(args.jobs, maxtasksperchild=1) as pool:
         results = pool.map(run, jobs, chunksize=1)
-    names = [Path(m).stem for m in MAPS]
+    names = [Path(m).stem for m in maps]
     print("| planner | " + " | ".join(f"{n}: solved, median s" for n in names) + " |")
-    print("|---|" + "---|" * len(MAPS))
+    print("|---|" + "---|" * len(maps))
     for planner in planners:
         cells = []
-        for m in MAPS:
+        for m in maps:
             mine = [r for r in results if r[0] == m and r[1] == planner]
             solved = [r for r in mine if r[2]]
             median = statistics.median(r[3] for r in mine)  # unsolved at the limit

@@ -9,7 +9,8 @@ Writes CSV files and PNG figures into --out:
 * fig9_10_volumes_3d_*.csv/png: 3D volumes vs inflation and vs the two aspect ratios;
 * eq38_extreme_rotation.csv: extreme rotation, closed forms vs numerical.
 
-Usage: python scripts/reproduce_paper.py --out docs/paper [--quick]
+Usage: python scripts/reproduce_paper.py --out docs/paper [--quick] [--samples 10000]
+    [--points K]
 """
 
 from __future__ import annotations
@@ -195,13 +196,16 @@ def aspect_grid(out: Path, alphas) -> None:
     import matplotlib.pyplot as plt
 
     k = len(alphas)
+    lo, hi = alphas[0], alphas[-1]
+    if hi == lo:  # one point (--points 1): give the image a width
+        lo, hi = lo - 0.05, hi + 0.05
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, col, label in [(axes[0], 7, "geometric / true"), (axes[1], 6, "convex / true")]:
         Z = np.array([r[col] for r in rows]).reshape(k, k)
         im = ax.imshow(
             Z.T,
             origin="lower",
-            extent=[alphas[0], alphas[-1], alphas[0], alphas[-1]],
+            extent=[lo, hi, lo, hi],
             aspect="auto",
             cmap="viridis",
         )
@@ -253,11 +257,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", required=True, type=Path, help="output folder")
     parser.add_argument("--quick", action="store_true", help="fewer sweep points")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--samples", type=int, default=10_000, help="random configurations of table 1"
+    )
+    parser.add_argument(
+        "--points",
+        type=int,
+        help="points of every sweep and per axis of the aspect grid (overrides --quick)",
+    )
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(args.seed)
     k = 4 if args.quick else 10
-    table1(args.out, 10_000, rng)
+    k3, grid = (4, 3) if args.quick else (7, 4)
+    if args.points is not None:
+        k = k3 = grid = args.points
+    table1(args.out, args.samples, rng)
     extreme_rotation_table(args.out)
     eps2 = np.linspace(0.02, 0.2, k)
     sweep(
@@ -277,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
         [(np.array([5.0, 5.0 / r]), 0.08) for r in ratios],
         "2D, a1 = 5, eps = 0.08 (Fig. 8)",
     )
-    eps3 = np.linspace(0.01, 0.2, 4 if args.quick else 7)
+    eps3 = np.linspace(0.01, 0.2, k3)
     sweep(
         args.out,
         "fig9_volumes_3d_inflation",
@@ -286,7 +301,7 @@ def main(argv: list[str] | None = None) -> int:
         [(A3, e) for e in eps3],
         "3D, a = [4, 2.5, 2] (paper Fig. 9)",
     )
-    aspect_grid(args.out, np.linspace(1.0, 1.2, 3 if args.quick else 4))
+    aspect_grid(args.out, np.linspace(1.0, 1.2, grid))
     return 0
 
 

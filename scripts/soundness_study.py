@@ -3,15 +3,18 @@
 Random worlds of thin rotated walls, balls, boxes and ellipsoids
 (:mod:`kcplan.world.clutter`; 2D and 3D, several robot shapes),
 random edges from a free state closer to an obstacle than the robot's size (short, medium
-and long, with and without rotation), each
-decided by the certifier with every certificate set of the ablation (``ca``, ``kc-paper``,
-``kc``). Every accepted edge is re-checked by gap-free conservative advancement with FCL
-clearances (:func:`kcplan.planning.verify.verify_path`, which shares no code with the
-certificates); a *violation* is an accepted edge that check finds in collision, and must
-be 0. A *free edge rejected* is a rejected edge the check finds free (the price of
-proving). Prints a Markdown table::
+and long, with and without rotation), each decided by the certifier (``--backend
+kernel``: the compiled :class:`kcplan.planning.kernel.KernelCertifier`, the default;
+``python``: the Python :class:`kcplan.planning.certifier.EdgeCertifier`) with every
+certificate set of the ablation (``ca``, ``kc-paper``, ``kc``). Every accepted edge is
+re-checked by gap-free conservative advancement with FCL clearances
+(:func:`kcplan.planning.verify.verify_path`, which shares no code with the certificates);
+a *violation* is an accepted edge that check finds in collision, and must be 0. A *free
+edge rejected* is a rejected edge the check finds free (the price of proving). Prints a
+Markdown table::
 
-    python scripts/soundness_study.py [--edges 100000] [--seed 1] [--dimensions 2 3]
+    python scripts/soundness_study.py [--edges 100000] [--seed 1] [--dimensions 2 3] \
+        [--backend kernel]
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import time
 import numpy as np
 
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
 from kcplan.world import CollisionWorld
@@ -33,7 +37,14 @@ SHAPES = {
 }
 
 
-def study(n: int, edges: int, rng: np.random.Generator) -> dict:
+def certifier(backend: str, world, a, kinds, ladder):
+    """The edge certifier of ``backend`` for ``world``'s robot (semi-axes ``a``)."""
+    if backend == "kernel":
+        return KernelCertifier(world, certificates=kinds, ladder=ladder)
+    return EdgeCertifier(world, a, kinds, ladder)
+
+
+def study(n: int, edges: int, rng: np.random.Generator, backend: str = "kernel") -> dict:
     """Counts per certificate set for ``edges`` random edges in ``n`` dimensions."""
     counts = {
         name: dict.fromkeys(("accepted", "violations", "free_rejected"), 0)
@@ -45,7 +56,7 @@ def study(n: int, edges: int, rng: np.random.Generator) -> dict:
         world = CollisionWorld(random_scenario(rng, n, a, int(rng.integers(6, 16))))
         ladder = GuardLadder(a)
         certifiers = {
-            name: EdgeCertifier(world, a, kinds, ladder if "polytope" in kinds else None)
+            name: certifier(backend, world, a, kinds, ladder if "polytope" in kinds else None)
             for name, kinds in CERTIFICATE_SETS.items()
         }
         for _ in range(200):
@@ -57,8 +68,8 @@ def study(n: int, edges: int, rng: np.random.Generator) -> dict:
             if rng.random() < 0.5:
                 p2[n:] = random_pose(rng, n, 0, 1)[n:]
             collides = verify_path(world, [p1, p2]).collides
-            for name, certifier in certifiers.items():
-                ok = certifier.check(p1, p2)
+            for name, decide in certifiers.items():
+                ok = decide.check(p1, p2)
                 c = counts[name]
                 c["accepted"] += ok
                 c["violations"] += ok and collides
@@ -74,13 +85,19 @@ def main() -> None:
     parser.add_argument("--edges", type=int, default=100_000, help="edges per dimension")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--dimensions", type=int, nargs="+", default=[2, 3], choices=[2, 3])
+    parser.add_argument(
+        "--backend",
+        choices=("kernel", "python"),
+        default="kernel",
+        help="who certifies: the compiled kernel (default) or the Python certifier",
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     print("| dimension | certificates | edges | accepted | violations | free edges rejected |")
     print("|---|---|---|---|---|---|")
     for n in args.dimensions:
         t0 = time.perf_counter()
-        counts = study(n, args.edges, rng)
+        counts = study(n, args.edges, rng, args.backend)
         for name, c in counts.items():
             print(
                 f"| {n}D | {name} | {args.edges} | {c['accepted']} | {c['violations']} "

@@ -131,4 +131,3 @@ class KernelCertifier:
 
 def _flat(pose: ArrayLike) -> list[float]:
     return np.asarray(pose, dtype=float).ravel().tolist()
-

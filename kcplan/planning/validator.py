@@ -111,7 +111,8 @@ class KCMotionValidator(ob.MotionValidator):
                 "backend: 'kernel' needs a kcplan.CollisionWorld, got "
                 f"{type(world).__name__} (use backend='python' for a world written in Python)"
             )
-        if backend == "kernel" and world.robot is not robot and robot.to_spec() != world.robot.to_spec():
+        same_robot = world.robot is robot or robot.to_spec() == world.robot.to_spec()
+        if backend == "kernel" and not same_robot:
             raise ValueError("robot: the kernel certifies the world's own robot; got another")
         options = (certificates, ladder, horizon, fallback, max_guards, sweep_test)
         if backend == "kernel":

@@ -1,0 +1,240 @@
+"""Every script in ``scripts/`` runs, with its smallest arguments, and prints what it should.
+
+The scripts are not imported by the package or its tests otherwise, so a renamed method
+would only break them when someone next runs them; here each is run in a subprocess
+(``sys.executable``, from the repository root) and its output checked. A new script
+without a case here fails :func:`test_every_script_has_a_case`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SCRIPTS = ROOT / "scripts"
+HRM = ROOT.parent / "shared" / "data" / "external" / "hrm" / "resources"
+CORRIDOR = "scenarios/2d/narrow_corridor.yaml"
+NUMBER = r"-?\d+(?:\.\d+)?"
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of a script: its arguments (``{tmp}``: a fresh folder, ``{hrm}``: the HRM
+    data), regular expressions its standard output must match, and files it must write."""
+
+    script: str
+    args: tuple[str, ...] = ()
+    expect: tuple[str, ...] = ()
+    files: tuple[str, ...] = ()
+    hrm: bool = False  # needs the HRM data (run with --help alone when it is absent)
+    check: Callable[[str, Path], None] | None = field(default=None, compare=False)
+
+
+def _same_suite(_out: str, tmp: Path) -> None:
+    """make_scenarios is deterministic: it writes the committed suite again."""
+    committed = sorted(
+        p.relative_to(ROOT / "scenarios") for p in ROOT.glob("scenarios/[23]d/*.yaml")
+    )
+    written = sorted(p.relative_to(tmp) for p in tmp.glob("[23]d/*.yaml"))
+    assert written == committed
+    for rel in committed:
+        assert (tmp / rel).read_text() == (ROOT / "scenarios" / rel).read_text(), rel
+
+
+def _no_violation(out: str, _tmp: Path) -> None:
+    rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 100 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
+    assert {(n, name) for n, name, *_ in rows} == {
+        (n, name) for n in ("2D", "3D") for name in ("ca", "kc-paper", "kc")
+    }
+    assert all(int(violations) == 0 for *_, violations, _ in rows), rows
+
+
+def _coal_report(out: str, _tmp: Path) -> None:
+    report = json.loads(out.strip().splitlines()[-1])
+    assert report["samples"] > 0 and report["violations"] == 0, report
+
+
+PAPER_FILES = (
+    "table1_confusion.csv",
+    "eq38_extreme_rotation.csv",
+    *(
+        f"{name}.{ext}"
+        for name in (
+            "fig7_volumes_2d_inflation",
+            "fig8_volumes_2d_aspect",
+            "fig9_volumes_3d_inflation",
+            "fig10_volumes_3d_aspect",
+        )
+        for ext in ("csv", "png")
+    ),
+)
+
+CASES = [
+    Case(
+        "bench_queries.py",
+        (CORRIDOR, "--poses", "50", "--blocks", "1"),
+        (r"collision us", rf"narrow_corridor\s+2\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}"),
+    ),
+    *(
+        Case(
+            "bisection_cost.py",
+            (CORRIDOR, "--edges", "30", "--plot", "{tmp}/cost.png", "--backend", backend),
+            (
+                r"\| scenario \| edge length / extent",
+                r"\| narrow_corridor \| 0\.2 \| \[[\d.]+, [\d.inf]+\) \| \d+ \| \d+% "
+                r"\| \d+ \| \d+ \|",
+                r"plot written to",
+            ),
+            ("cost.png",),
+        )
+        for backend in ("kernel", "python")
+    ),
+    Case(
+        "coal_distance_error.py",
+        ("--samples", "200"),
+        (r"\| halfspace aligned 3D \|",),
+        check=_coal_report,
+    ),
+    Case(
+        "compare_validators.py",
+        (CORRIDOR, "--runs", "1", "--time", "2"),
+        tuple(
+            rf"\| narrow_corridor \| {name} \| 1/1 \| {NUMBER} \| \d+ \| 0 \|"
+            for name in ("kc-rrtconnect", "kc-prm")  # solved, and no colliding path
+        )
+        + (r"\| narrow_corridor \| rrtconnect \|", r"\| narrow_corridor \| prm \|"),
+    ),
+    *(
+        Case(
+            "edge_cost.py",
+            (CORRIDOR, planner, "1", "--poses", "200", "--time", "5"),
+            (
+                rf"^\| narrow_corridor \| {planner} \| 1 \| {NUMBER} \| [1-9]\d* \| [1-9]\d* "
+                rf"\| {NUMBER} \| {NUMBER} \|$",
+            ),
+        )
+        for planner in ("kc-rrtconnect", "kc-rrtconnect-py")
+    ),
+    Case(
+        "hrm_settings_check.py",
+        ("--hrm", "{hrm}"),
+        (r"\| map \| robot \|", r"\| sparse \| \w+ \| [^|]+ \| [^|]+ \| (yes|no) \|"),
+        hrm=True,
+    ),
+    Case(
+        "import_real_maps.py",
+        ("--hrm", "{hrm}", "--out", "{tmp}", "--maps", "hrm_ellipse_sparse_2d"),
+        (r"hrm_ellipse_sparse_2d\.yaml: .*2D, \d+ obstacles",),
+        ("hrm_ellipse_sparse_2d.yaml",),
+        hrm=True,
+    ),
+    Case(
+        "make_scenarios.py",
+        ("--out", "{tmp}", "--no-pictures"),
+        (r"2d/narrow_corridor\.yaml: \d+ obstacles", r"3d/box_field\.yaml: \d+ obstacles"),
+        ("3d/meshes/rock.stl",),
+        check=_same_suite,
+    ),
+    *(
+        Case(
+            "map_scaling.py",
+            ("--counts", "10", "--edges", "50", "--runs", "1", "--time", "5", "--backend", b),
+            (
+                rf"\| map \| FCL objects \| .* \| {certified} \[s\] \| {stock} \[s\] \|",
+                rf"\| clutter 10 \| 10 \| {NUMBER} \| \d+ \| {NUMBER} \|",
+                r"\| movingai maze-128 \| \d+ \|",
+            ),
+        )
+        for b, certified, stock in (
+            ("kernel", "kc-rrtconnect", "rrtconnect"),
+            ("python", "kc-rrtconnect-py", "rrtconnect-fcl"),
+        )
+    ),
+    Case(
+        "own_setup_example.py",
+        (),
+        (r"solved: \d+ states", r"verified: free", r"validator counters"),
+    ),
+    Case(
+        "planner_settings.py",
+        (CORRIDOR, "--runs", "1", "--ranges", "0.2", "--neighbors", "10", "--time", "2"),
+        (
+            rf"\| narrow_corridor \| kc-rrtconnect \| range 0\.2 \| 1/1 \| {NUMBER} \| \d+ \|",
+            rf"\| narrow_corridor \| kc-prm \| k = 10 \| 1/1 \| {NUMBER} \| \d+ \|",
+            r"\| narrow_corridor \| rrtconnect \| range 0\.2 \|",
+        ),
+    ),
+    Case(
+        "planner_table.py",
+        ("--runs", "1", "--time", "2", "--jobs", "1", "--maps", CORRIDOR)
+        + ("--planners", "rrtconnect"),
+        (
+            r"\| planner \| narrow_corridor: solved, median s \|",
+            rf"\| `kc-rrtconnect` \| 1/1, {NUMBER} \|",  # no "(1 colliding)"
+            r"\| `rrtconnect` \| \d/1, ",
+        ),
+    ),
+    Case(
+        "reproduce_paper.py",
+        ("--out", "{tmp}", "--points", "1", "--samples", "1000"),
+        files=PAPER_FILES,
+    ),
+    *(
+        Case(
+            "soundness_study.py",
+            ("--edges", "100", "--backend", backend),
+            (r"\| dimension \| certificates \| edges \|",),
+            check=_no_violation,
+        )
+        for backend in ("kernel", "python")
+    ),
+]
+
+
+def test_every_script_has_a_case():
+    assert {case.script for case in CASES} == {p.name for p in SCRIPTS.glob("*.py")}
+
+
+def _id(case: Case) -> str:
+    backend = [case.args[i + 1] for i, a in enumerate(case.args) if a == "--backend"]
+    planner = [a for a in case.args if a.startswith("kc-")]
+    return "-".join([case.script.removesuffix(".py"), *backend, *planner])
+
+
+@pytest.mark.parametrize("case", CASES, ids=_id)
+def test_script_runs(case: Case, tmp_path):
+    help_only = case.hrm and not HRM.is_dir()
+    args = (
+        ["--help"]
+        if help_only
+        else [a.replace("{tmp}", str(tmp_path)).replace("{hrm}", str(HRM)) for a in case.args]
+    )
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPTS / case.script), *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    assert "leaked" not in proc.stderr, proc.stderr[-4000:]  # nanobind: a cycle not broken
+    if help_only:
+        assert "usage:" in proc.stdout
+        pytest.skip(f"{HRM} is absent: ran {case.script} --help only")
+    for pattern in case.expect:
+        assert re.search(pattern, proc.stdout, re.M), (pattern, proc.stdout[-4000:])
+    for name in case.files:
+        assert (tmp_path / name).stat().st_size > 0, name
+    if case.check is not None:
+        case.check(proc.stdout, tmp_path)
