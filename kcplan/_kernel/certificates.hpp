@@ -114,6 +114,9 @@ class KCPolytope final : public Certificate {
       if (rows_[l].empty() || rows_[l].size() % width ||
           (l && !(levels_[l] > levels_[l - 1])))
         throw std::invalid_argument("ladder: levels must increase and rows be count x width");
+    for (const std::vector<double>& block : rows_)
+      for (double v : block)
+        if (!std::isfinite(v)) throw std::invalid_argument("ladder: rows must be finite");
   }
   const char* name() const override { return "polytope"; }
   void reach(const Guard& guard, const Edge& edge, double m, double& minus,

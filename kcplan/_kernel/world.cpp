@@ -122,7 +122,8 @@ World::World(const Robot& robot, double half_height, double rtol, double atol)
 
 void World::add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
                 const coal::Transform3s& transform, Support support) {
-  if (finalized_) throw std::logic_error("world: obstacles must be added before finalize()");
+  if (finalized_)
+    throw std::invalid_argument("world: obstacles must be added before the first query");
   auto object = std::make_unique<coal::CollisionObject>(geometry, transform);
   object->computeAABB();
   object->setUserData(reinterpret_cast<void*>(supports_.size()));
@@ -306,7 +307,8 @@ double World::distance(coal::CollisionObject& object) {
   tune(callback.data.request);
   callback.init();
   manager_->distance(&object, &callback);
-  return std::max(callback.data.result.min_distance, 0.0);
+  const double d = callback.data.result.min_distance;
+  return d > 0.0 ? d : 0.0;  // an overlap, or anything coal cannot tell (NaN): no clearance
 }
 
 bool World::in_collision(const Pose& pose) {
