@@ -197,7 +197,8 @@ NB_MODULE(_core, m) {
              require(c.world(), 3);
              return c.check(se3(x1, y1, z1, a1, b1, c1, d1), se3(x2, y2, z2, a2, b2, c2, d2),
                             resolution);
-           })
+           }, "x1"_a, "y1"_a, "z1"_a, "qx1"_a, "qy1"_a, "qz1"_a, "qw1"_a, "x2"_a, "y2"_a, "z2"_a,
+           "qx2"_a, "qy2"_a, "qz2"_a, "qw2"_a, "resolution"_a = 0.01)
       .def("state_valid",
            [](kcplan::EdgeCertifier& c, const std::vector<double>& p) {
              return c.state_valid(pose_of(p, c.world().robot().dimension()));

@@ -38,23 +38,50 @@ void require_finite(const double* v, std::size_t n, const char* what) {
       throw std::invalid_argument(std::string(what) + ": expected finite numbers");
 }
 
+void require_positive(const double* v, std::size_t n, const char* message) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(v[i] > 0.0) || !std::isfinite(v[i])) throw std::invalid_argument(message);
+}
+
+Vec3s vec(const std::array<double, 3>& v) { return Vec3s(v[0], v[1], v[2]); }
+
+/// Finite points from m x 3 flat numbers.
+std::vector<Vec3s> points_of(const std::vector<double>& flat, const char* what) {
+  if (flat.size() % 3) throw std::invalid_argument(std::string(what) + ": expected m x 3 vertices");
+  require_finite(flat.data(), flat.size(), what);
+  std::vector<Vec3s> points;
+  points.reserve(flat.size() / 3);
+  for (std::size_t i = 0; i < flat.size(); i += 3)
+    points.emplace_back(flat[i], flat[i + 1], flat[i + 2]);
+  return points;
+}
+
+/// Triangles from t x 3 flat indices into m vertices.
+std::vector<coal::Triangle> triangles_of(const std::vector<int>& flat, std::size_t m,
+                                         const char* what) {
+  if (flat.size() % 3)
+    throw std::invalid_argument(std::string(what) + ": expected t x 3 triangle indices");
+  std::vector<coal::Triangle> faces;
+  faces.reserve(flat.size() / 3);
+  for (std::size_t i = 0; i < flat.size(); i += 3) {
+    for (std::size_t j = i; j < i + 3; ++j)
+      if (flat[j] < 0 || static_cast<std::size_t>(flat[j]) >= m)
+        throw std::invalid_argument(std::string(what) + ": triangle index out of range");
+    faces.emplace_back(flat[i], flat[i + 1], flat[i + 2]);
+  }
+  return faces;
+}
+
 /// A convex polytope with its triangles: coal fills the vertex neighbours from them.
 std::shared_ptr<coal::CollisionGeometry> convex(const std::vector<Vec3s>& points,
                                                 const std::vector<int>& triangles) {
-  const std::size_t m = points.size(), t = triangles.size() / 3;
-  if (m < 4 || t < 4 || triangles.size() != 3 * t)
+  const std::size_t m = points.size();
+  if (m < 4 || triangles.size() < 12)
     throw std::invalid_argument("convex: expected at least 4 vertices and 4 triangles");
-  auto vertices = std::make_shared<std::vector<Vec3s>>(points);
-  auto faces = std::make_shared<std::vector<coal::Triangle>>();
-  faces->reserve(t);
-  for (std::size_t i = 0; i < t; ++i) {
-    for (int j = 0; j < 3; ++j)
-      if (triangles[3 * i + j] < 0 || static_cast<std::size_t>(triangles[3 * i + j]) >= m)
-        throw std::invalid_argument("convex: triangle index out of range");
-    faces->emplace_back(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
-  }
+  auto faces = std::make_shared<std::vector<coal::Triangle>>(triangles_of(triangles, m, "convex"));
   auto shape = std::make_shared<coal::Convex<coal::Triangle>>(
-      vertices, static_cast<unsigned int>(m), faces, static_cast<unsigned int>(t));
+      std::make_shared<std::vector<Vec3s>>(points), static_cast<unsigned int>(m), faces,
+      static_cast<unsigned int>(faces->size()));
   shape->computeLocalAABB();
   return shape;
 }
@@ -164,9 +191,7 @@ void World::add_box(const std::array<double, 3>& centre, const std::array<double
                     const std::array<double, 3>& half) {
   require_finite(centre.data(), 3, "box");
   require_finite(rotation.data(), 9, "box");
-  for (double h : half)
-    if (!(h > 0.0) || !std::isfinite(h))
-      throw std::invalid_argument("box: expected positive finite half sides");
+  require_positive(half.data(), 3, "box: expected positive finite half sides");
   const coal::Matrix3s R = matrix(rotation);
   Support support;
   support.kind = Support::kPoints;
@@ -174,13 +199,13 @@ void World::add_box(const std::array<double, 3>& centre, const std::array<double
   for (int c = 0; c < 8; ++c) {  // corner 4i + 2j + k has signs (i, j, k)
     const Vec3s local((c & 4 ? 1 : -1) * half[0], (c & 2 ? 1 : -1) * half[1],
                       (c & 1 ? 1 : -1) * half[2]);
-    const Vec3s x = Vec3s(centre[0], centre[1], centre[2]) + R * local;
+    const Vec3s x = vec(centre) + R * local;
     corners.push_back(x);
     support.points.insert(support.points.end(), {x[0], x[1], x[2]});
   }
   if (R.isIdentity(0.0)) {
     add(std::make_shared<coal::Box>(2 * half[0], 2 * half[1], 2 * half[2]),
-        coal::Transform3s(coal::Matrix3s::Identity(), Vec3s(centre[0], centre[1], centre[2])),
+        coal::Transform3s(coal::Matrix3s::Identity(), vec(centre)),
         std::move(support));
     return;
   }
@@ -190,11 +215,7 @@ void World::add_box(const std::array<double, 3>& centre, const std::array<double
 }
 
 void World::add_convex(const std::vector<double>& vertices, const std::vector<int>& triangles) {
-  if (vertices.size() % 3) throw std::invalid_argument("convex: expected m x 3 vertices");
-  require_finite(vertices.data(), vertices.size(), "convex");
-  std::vector<Vec3s> points;
-  for (std::size_t i = 0; i < vertices.size(); i += 3)
-    points.emplace_back(vertices[i], vertices[i + 1], vertices[i + 2]);
+  const std::vector<Vec3s> points = points_of(vertices, "convex");
   Support support;
   support.kind = Support::kPoints;
   support.points = vertices;
@@ -203,14 +224,13 @@ void World::add_convex(const std::vector<double>& vertices, const std::vector<in
 
 void World::add_sphere(const std::array<double, 3>& centre, double radius) {
   require_finite(centre.data(), 3, "sphere");
-  if (!(radius > 0.0) || !std::isfinite(radius))
-    throw std::invalid_argument("sphere: expected a positive finite radius");
+  require_positive(&radius, 1, "sphere: expected a positive finite radius");
   Support support;
   support.kind = Support::kBall;
   support.centre = centre;
   support.radius = radius;
   add(std::make_shared<coal::Sphere>(radius),
-      coal::Transform3s(coal::Matrix3s::Identity(), Vec3s(centre[0], centre[1], centre[2])),
+      coal::Transform3s(coal::Matrix3s::Identity(), vec(centre)),
       std::move(support));
 }
 
@@ -219,9 +239,7 @@ void World::add_ellipsoid(const std::array<double, 3>& centre,
                           const std::array<double, 3>& extents) {
   require_finite(centre.data(), 3, "ellipsoid");
   require_finite(rotation.data(), 9, "ellipsoid");
-  for (double e : extents)
-    if (!(e > 0.0) || !std::isfinite(e))
-      throw std::invalid_argument("ellipsoid: expected positive finite semi-axes");
+  require_positive(extents.data(), 3, "ellipsoid: expected positive finite semi-axes");
   Support support;
   support.kind = Support::kEllipsoid;
   support.centre = centre;
@@ -232,27 +250,18 @@ void World::add_ellipsoid(const std::array<double, 3>& centre,
       support.shape[3 * r + c] =
           (dimension_ == 2 && r == 2) ? 0.0 : extents[r] * rotation[3 * c + r];
   add(std::make_shared<coal::Ellipsoid>(extents[0], extents[1], extents[2]),
-      coal::Transform3s(matrix(rotation), Vec3s(centre[0], centre[1], centre[2])),
+      coal::Transform3s(matrix(rotation), vec(centre)),
       std::move(support));
 }
 
 void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles) {
-  const std::size_t m = vertices.size() / 3, t = triangles.size() / 3;
-  if (m < 3 || t < 1 || vertices.size() != 3 * m || triangles.size() != 3 * t)
+  std::vector<Vec3s> points = points_of(vertices, "mesh");
+  std::vector<coal::Triangle> faces = triangles_of(triangles, points.size(), "mesh");
+  if (points.size() < 3 || faces.empty())
     throw std::invalid_argument("mesh: expected m x 3 vertices and t x 3 triangles");
-  require_finite(vertices.data(), vertices.size(), "mesh");
-  std::vector<Vec3s> points;
-  std::vector<coal::Triangle> faces;
-  for (std::size_t i = 0; i < m; ++i)
-    points.emplace_back(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]);
-  for (std::size_t i = 0; i < t; ++i) {
-    for (int j = 0; j < 3; ++j)
-      if (triangles[3 * i + j] < 0 || static_cast<std::size_t>(triangles[3 * i + j]) >= m)
-        throw std::invalid_argument("mesh: triangle index out of range");
-    faces.emplace_back(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
-  }
   auto model = std::make_shared<coal::BVHModel<coal::OBBRSS>>();
-  model->beginModel(static_cast<unsigned int>(t), static_cast<unsigned int>(m));
+  model->beginModel(static_cast<unsigned int>(faces.size()),
+                    static_cast<unsigned int>(points.size()));
   model->addSubModel(points, faces);
   model->endModel();
   model->computeLocalAABB();

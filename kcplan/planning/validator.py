@@ -111,14 +111,13 @@ class KCMotionValidator(ob.MotionValidator):
                 "backend: 'kernel' needs a kcplan.CollisionWorld, got "
                 f"{type(world).__name__} (use backend='python' for a world written in Python)"
             )
-        same_robot = world.robot is robot or robot.to_spec() == world.robot.to_spec()
-        if backend == "kernel" and not same_robot:
-            raise ValueError("robot: the kernel certifies the world's own robot; got another")
-        options = (certificates, ladder, horizon, fallback, max_guards, sweep_test)
         if backend == "kernel":
-            self.certifier = KernelCertifier(world, *options)
+            if world.robot is not robot and robot.to_spec() != world.robot.to_spec():
+                raise ValueError("robot: the kernel certifies the world's own robot; got another")
+            self.certifier = KernelCertifier(
+                world, certificates, ladder, horizon, fallback, max_guards, sweep_test
+            )
         else:
-            certificates, ladder, horizon, fallback, max_guards, sweep_test = options
             self.certifier = EdgeCertifier(
                 world, robot, certificates, ladder, horizon, fallback, max_guards, sweep_test
             )
@@ -126,10 +125,11 @@ class KCMotionValidator(ob.MotionValidator):
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
         self.error: Exception | None = None
-        if backend == "kernel" and fallback != "discrete":
-            # the hot path: one call into the kernel with the two poses, nothing else
-            self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
+        if backend == "kernel":
+            # the hot path: one call into the kernel with the pose(s), nothing else
             self.state_valid = self._valid_kernel_se2 if self.n == 2 else self._valid_kernel_se3
+            if fallback != "discrete":  # the discrete fallback needs OMPL's resolution
+                self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
 
     @property
     def counters(self) -> dict:
@@ -146,7 +146,7 @@ class KCMotionValidator(ob.MotionValidator):
 
     def _check_kernel_se2(self, s1, s2) -> bool:
         try:
-            return self.certifier.check_se2(
+            return self.error is None and self.certifier.check_se2(
                 s1.getX(), s1.getY(), s1.getYaw(), s2.getX(), s2.getY(), s2.getYaw()
             )
         except Exception as err:  # noqa: BLE001 - see checkMotion
@@ -155,9 +155,9 @@ class KCMotionValidator(ob.MotionValidator):
     def _check_kernel_se3(self, s1, s2) -> bool:
         try:
             r1, r2 = s1.rotation(), s2.rotation()
-            return self.certifier.check_se3(
+            return self.error is None and self.certifier.check_se3(
                 s1.getX(), s1.getY(), s1.getZ(), r1.x, r1.y, r1.z, r1.w,
-                s2.getX(), s2.getY(), s2.getZ(), r2.x, r2.y, r2.z, r2.w, 0.01,
+                s2.getX(), s2.getY(), s2.getZ(), r2.x, r2.y, r2.z, r2.w,
             )  # fmt: skip
         except Exception as err:  # noqa: BLE001 - see checkMotion
             return self._fail(err)

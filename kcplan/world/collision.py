@@ -244,7 +244,7 @@ class CollisionWorld:
             )
         # plain floats: numpy costs microseconds per call on 4-vectors
         values = p.tolist()
-        if not all(math.isfinite(v) for v in values):
+        if not all(map(math.isfinite, values)):
             raise ValueError(f"pose: expected finite numbers, got {values}")
         if self.dimension == 2:
             x, y, yaw = values
