@@ -7,6 +7,7 @@ import os
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib import colors as mcolors
 
 from kcplan.bench.summary import cost_at, solution_time
 from kcplan.viz import plt, save_figure  # pyplot with the Agg backend kcplan.viz chose
@@ -25,12 +26,20 @@ _COLORS = {
     "kc-prm-paper": "#bcbd22",
     "rrtconnect-fine": "#ff7f0e",
     "prm-fine": "#9467bd",
+    "kc-rrtconnect-py": "#393b79",
+    "kc-prm-py": "#843c39",
+    "rrtconnect-fcl": "#7f7f7f",
+    "prm-fcl": "#c7c7c7",
 }
 
 
 def _color(planner: str, i: int) -> str:
-    # planners without a colour of their own: matplotlib's qualitative cycle
-    return _COLORS.get(planner, plt.cm.tab10(i % 10))
+    # planners without a colour of their own: matplotlib's qualitative cycle, less the
+    # colours the named planners have (else e.g. a fourth planner drew kc-prm's red)
+    if planner in _COLORS:
+        return _COLORS[planner]
+    free = [c for c in map(mcolors.to_hex, plt.cm.tab20.colors) if c not in _COLORS.values()]
+    return free[i % len(free)]
 
 
 def _planners(records: Sequence[dict]) -> list[str]:
