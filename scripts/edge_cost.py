@@ -128,9 +128,10 @@ def main() -> None:
         kernel = world.kernel.counters
         queries = sum(kernel[key] for key in QUERY_KEYS)
         rest = timer.seconds
+    per_edge = f"{1e6 * r.time / edges:.1f}" if edges else "-"  # a stock planner has none
     print(
         f"| {scenario.name} | {args.planner} | {args.seed} | {r.time:.3f} | {edges} "
-        f"| {queries} | {1e6 * r.time / max(edges, 1):.1f} | {1e6 * rest / calls:.1f} |"
+        f"| {queries} | {per_edge} | {1e6 * rest / calls:.1f} |"
     )
 
 
