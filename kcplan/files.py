@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -17,17 +18,30 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
 
     The temporary file keeps the target's suffix (matplotlib and sqlite look at it). On an
     exception, including ``KeyboardInterrupt``, the temporary file is removed and ``path``
-    is left as it was.
+    is left as it was. The file gets the mode an ordinary ``open`` would give it: a
+    replaced file keeps its mode, a new one gets ``0666`` less the umask (``mkstemp``
+    alone would leave ``0600``, unreadable to the rest of a shared or served folder).
     """
     target = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=target.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, _output_mode(target))
         os.replace(tmp, target)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def _output_mode(target: Path) -> int:
+    """The mode ``target`` keeps if it exists, else ``0666`` less the process's umask."""
+    try:
+        return stat.S_IMODE(target.stat().st_mode)
+    except FileNotFoundError:
+        umask = os.umask(0)  # the only portable way to read it; restored at once
+        os.umask(umask)
+        return 0o666 & ~umask
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:

@@ -1,5 +1,7 @@
 import json
 import math
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -157,3 +159,24 @@ def test_html_view_renders_the_scene_in_a_headless_browser(tmp_path, capsys):
     # obstacles (grey), the goal (red) and the robot on its path (blue) are on the page
     assert grey > 0.005 and red > 0.0002 and blue > 0.0002, (grey, red, blue)
     assert main(["show", scenario, "--html", str(tmp_path / "x.txt")]) == 2
+
+
+def test_output_files_honour_the_umask_and_keep_a_replaced_files_mode(tmp_path, capsys):
+    """mkstemp alone gave every output 0600: unreadable in a shared or served folder."""
+    out, png = tmp_path / "open.json", tmp_path / "open.png"
+    argv = ["plan", OPEN_FIELD, "--seed", "1", "--time", "2", "-o", str(out), "--plot", str(png)]
+    old = os.umask(0o022)
+    try:
+        assert main(argv) == 0
+        assert stat.S_IMODE(out.stat().st_mode) == 0o644
+        assert stat.S_IMODE(png.stat().st_mode) == 0o644
+        os.umask(0o077)  # a new file follows the umask ...
+        assert main([*argv[:-4], "-o", str(tmp_path / "private.json")]) == 0
+        assert stat.S_IMODE((tmp_path / "private.json").stat().st_mode) == 0o600
+        out.chmod(0o640)  # ... a replaced one keeps its own mode
+        assert main(argv) == 0
+        assert stat.S_IMODE(out.stat().st_mode) == 0o640
+        assert stat.S_IMODE(png.stat().st_mode) == 0o644
+    finally:
+        os.umask(old)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["open.json", "open.png", "private.json"]
