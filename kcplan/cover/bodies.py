@@ -1,0 +1,79 @@
+"""Robot bodies as point sets: conversion from enclosing ellipsoids, membership, volume.
+
+A :class:`kcplan.geometry.robot.Body` (semi-axes and a pose in the robot's frame) is the
+ellipsoid ``{x : (x - p)^T M (x - p) <= 1}`` with ``M = R diag(1 / a^2) R^T``;
+:func:`body_matrix` computes ``M`` from the very numbers a scenario stores, so a check
+with it is a check of the robot the planner uses.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from kcplan.geometry.enclosing import ellipsoid_axes, mahalanobis_sq
+from kcplan.geometry.pose import quaternion_matrix
+from kcplan.geometry.robot import Body
+from kcplan.geometry.rotations import exp_rotation
+
+__all__ = ["body_from_ellipsoid", "body_matrix", "body_holds", "inside_union", "union_volume"]
+
+
+def body_from_ellipsoid(center: ArrayLike, M: ArrayLike, sphere: bool = False) -> Body:
+    """The body ``{x : (x - c)^T M (x - c) <= 1}``; ``sphere`` stores a ball (``M`` a
+    multiple of the identity) with the identity orientation."""
+    c = np.asarray(center, dtype=float)
+    n = len(c)
+    a, R = ellipsoid_axes(M)
+    if sphere:
+        a, R = np.full(n, a.max()), np.eye(n)
+    if n == 2:
+        pose = np.append(c, math.atan2(R[1, 0], R[0, 0]))
+    else:
+        pose = np.concatenate([c, Rotation.from_matrix(R).as_quat()])  # [x, y, z, w]
+    return Body(a, pose)
+
+
+def body_matrix(body: Body) -> NDArray[np.float64]:
+    """The shape matrix ``M = R diag(1 / a^2) R^T`` of a body, shape ``(n, n)``."""
+    n = body.dimension
+    R = exp_rotation([body.pose[2]], 2) if n == 2 else quaternion_matrix(body.pose[3:])
+    return R @ np.diag(1.0 / body.semi_axes**2) @ R.T
+
+
+def body_holds(body: Body, points: ArrayLike) -> float:
+    """The largest ``(x - p)^T M (x - p)`` of the points: at most 1 when the body holds
+    them all."""
+    return float(mahalanobis_sq(points, body.position, body_matrix(body)).max())
+
+
+def inside_union(points: ArrayLike, bodies: tuple[Body, ...] | list[Body]) -> NDArray[np.bool_]:
+    """Whether each point lies in some body, shape ``(m,)``."""
+    P = np.asarray(points, dtype=float)
+    out = np.zeros(len(P), dtype=bool)
+    for body in bodies:
+        out |= mahalanobis_sq(P, body.position, body_matrix(body)) <= 1.0
+    return out
+
+
+def union_volume(
+    bodies: tuple[Body, ...] | list[Body], samples: int = 400_000, seed: int = 0
+) -> tuple[float, float]:
+    """Monte Carlo volume (area in 2D) of the union of bodies and its standard error.
+
+    Uniform samples in the union's bounding box; the standard error is
+    ``box * sqrt(f (1 - f) / samples)`` for the fraction ``f`` inside.
+    """
+    low, high = [], []
+    for body in bodies:
+        half = np.sqrt(np.diag(np.linalg.inv(body_matrix(body))))  # extent along each axis
+        low.append(body.position - half)
+        high.append(body.position + half)
+    low, high = np.min(low, axis=0), np.max(high, axis=0)
+    box = float(np.prod(high - low))
+    rng = np.random.default_rng(seed)
+    f = float(inside_union(rng.uniform(low, high, (samples, len(low))), bodies).mean())
+    return box * f, box * math.sqrt(f * (1.0 - f) / samples)

@@ -1,0 +1,153 @@
+"""Ellipsoids that enclose point sets: the minimum-volume one, and exact enclosure.
+
+An ellipsoid here is a centre ``c`` (shape ``(n,)``) and a symmetric positive-definite
+*shape matrix* ``M`` (shape ``(n, n)``): ``E = {x : (x - c)^T M (x - c) <= 1}``. Its
+semi-axes are ``1 / sqrt(eig(M))`` along the eigenvectors of ``M``.
+
+:func:`minimum_volume_ellipsoid` is Khachiyan's first-order algorithm for the minimum-
+volume enclosing ellipsoid (MVEE; Khachiyan, "Rounding of polytopes in the real number
+model of computation", Math. Oper. Res. 21, 1996; in the form of Todd and Yildirim, "On
+Khachiyan's algorithm for the computation of minimum-volume enclosing ellipsoids",
+Discrete Appl. Math. 155, 2007, with their away steps and Kumar and Yildirim's start).
+It is an *approximation*: the ellipsoid it returns need
+not contain every point. :func:`enclose` makes containment exact by scaling about the
+centre, which is what a sound cover needs; the approximation then only costs volume, at
+most a factor ``(1 + tol)^(n/2)`` over the optimum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import ConvexHull, QhullError
+
+__all__ = [
+    "ellipsoid_axes",
+    "ellipsoid_volume",
+    "enclose",
+    "mahalanobis_sq",
+    "minimum_volume_ellipsoid",
+]
+
+FLAT_RATIO = 1e-9
+"""Point sets whose thinnest principal spread is below this fraction of the widest are
+treated as flat (Khachiyan's iteration needs a full-dimensional set)."""
+
+
+def mahalanobis_sq(points: ArrayLike, center: ArrayLike, M: ArrayLike) -> NDArray[np.float64]:
+    """``(x - c)^T M (x - c)`` of every point, shape ``(m,)``: at most 1 inside ``E``."""
+    X = np.asarray(points, dtype=float) - np.asarray(center, dtype=float)
+    return np.einsum("mi,ij,mj->m", X, np.asarray(M, dtype=float), X)
+
+
+def ellipsoid_volume(M: ArrayLike) -> float:
+    """Volume (area in 2D) of ``E``: ``omega_n / sqrt(det M)``."""
+    M = np.asarray(M, dtype=float)
+    unit = np.pi if len(M) == 2 else 4.0 * np.pi / 3.0
+    return float(unit / np.sqrt(np.linalg.det(M)))
+
+
+def ellipsoid_axes(M: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Semi-axes ``(n,)`` and a rotation ``R`` ``(n, n)`` (``det R = +1``) with
+    ``M = R diag(1 / a^2) R^T``; the axes are in increasing order of length."""
+    w, R = np.linalg.eigh(np.asarray(M, dtype=float))
+    a = 1.0 / np.sqrt(w)
+    order = np.argsort(a)
+    a, R = a[order], R[:, order]
+    if np.linalg.det(R) < 0:
+        R[:, 0] = -R[:, 0]
+    return a, R
+
+
+def _flat_ellipsoid(P: NDArray) -> tuple[NDArray, NDArray]:
+    """An ellipsoid around the principal box of a (nearly) flat point set, with the thin
+    axes given a thickness of :data:`FLAT_RATIO` of the widest (enclose() finishes it)."""
+    c = 0.5 * (P.min(axis=0) + P.max(axis=0))
+    _, _, Vt = np.linalg.svd(P - c, full_matrices=False)
+    local = (P - c) @ Vt.T
+    mid = 0.5 * (local.min(axis=0) + local.max(axis=0))
+    half = 0.5 * np.ptp(local, axis=0)
+    half = np.maximum(half, FLAT_RATIO * max(float(half.max()), float(np.abs(P).max()), 1e-30))
+    c = c + mid @ Vt
+    a = np.sqrt(len(c)) * half  # the box's corners lie on this ellipsoid
+    return c, Vt.T @ np.diag(1.0 / a**2) @ Vt
+
+
+def minimum_volume_ellipsoid(
+    points: ArrayLike, tol: float = 1e-3, max_iterations: int = 20_000
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Approximate minimum-volume ellipsoid around points (Khachiyan's algorithm).
+
+    Parameters
+    ----------
+    points : array_like, shape (m, n)
+        ``n`` is 2 or 3; at least one point.
+    tol : float
+        Stop when every point ``x`` has ``(x - c)^T M (x - c) <= (1 + tol)`` in the
+        iteration's scale (Todd and Yildirim's ``epsilon``).
+    max_iterations : int
+        Safety limit; the result is still an ellipsoid near the points.
+
+    Returns
+    -------
+    center : ndarray, shape (n,)
+    M : ndarray, shape (n, n)
+        Not guaranteed to contain every point: pass the result through :func:`enclose`.
+    """
+    P = np.asarray(points, dtype=float)
+    if P.ndim != 2 or len(P) == 0 or P.shape[1] not in (2, 3):
+        raise ValueError(f"points: expected an (m, 2) or (m, 3) array, got shape {P.shape}")
+    n = P.shape[1]
+    spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
+    if len(P) <= n or spread[-1] <= FLAT_RATIO * max(float(spread[0]), 1e-300):
+        return _flat_ellipsoid(P)
+    try:  # only hull vertices can touch the MVEE
+        P = P[ConvexHull(P).vertices]
+    except QhullError:
+        return _flat_ellipsoid(P)
+    origin = P.mean(axis=0)
+    X = P - origin
+    Q = np.vstack([X.T, np.ones(len(X))])  # lifted points, (n + 1, m)
+    # Kumar and Yildirim's start: the extreme points along each axis
+    u = np.zeros(len(X))
+    u[np.unique(np.concatenate([X.argmin(axis=0), X.argmax(axis=0)]))] = 1.0
+    u = 0.9 * u / u.sum() + 0.1 / len(X)  # every point keeps weight: V starts regular
+    d = n + 1
+    for _ in range(max_iterations):
+        g = np.einsum("im,im->m", Q, np.linalg.inv((Q * u) @ Q.T) @ Q)
+        j = int(np.argmax(g))
+        k = int(np.argmin(np.where(u > 0, g, np.inf)))
+        grow, shrink = g[j] / d - 1.0, 1.0 - g[k] / d
+        if grow <= tol:
+            break
+        if grow >= shrink:  # Khachiyan's step towards the worst point
+            step = (g[j] - d) / (d * (g[j] - 1.0))
+            u *= 1.0 - step
+            u[j] += step
+        else:  # Todd and Yildirim's away step from the weakest support point
+            step = min((d - g[k]) / (d * (g[k] - 1.0)), u[k] / (1.0 - u[k]))
+            u *= 1.0 + step
+            u[k] -= step
+            u[k] = max(u[k], 0.0)
+    c = X.T @ u
+    S = (X.T * u) @ X - np.outer(c, c)
+    try:
+        return c + origin, np.linalg.inv(S) / n
+    except np.linalg.LinAlgError:  # pragma: no cover - the support collapsed
+        return _flat_ellipsoid(P)
+
+
+def enclose(
+    points: ArrayLike, center: ArrayLike, M: ArrayLike, margin: float = 1e-9
+) -> NDArray[np.float64]:
+    """Scale ``E`` about its centre so that every point lies inside with room to spare.
+
+    Returns ``M / s^2`` with ``s = sqrt(max (x - c)^T M (x - c)) (1 + margin)``: every
+    point then has ``(x - c)^T M' (x - c) <= (1 + margin)^-2``, which leaves room for
+    rounding in later conversions (to semi-axes and a quaternion) and in the points
+    themselves (see :mod:`kcplan.cover.partition`).
+    """
+    M = np.asarray(M, dtype=float)
+    worst = float(mahalanobis_sq(points, center, M).max())
+    s2 = max(worst, 1e-300) * (1.0 + margin) ** 2
+    return M / s2
