@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kcplan.cli import main
+from kcplan.geometry.polygon import convex_pieces, polygon_area
 from kcplan.world import (
     ScenarioError,
     dump_scenario,
@@ -19,7 +20,6 @@ from kcplan.world import (
     parse_scenario,
     scenario_to_dict,
 )
-from kcplan.world.polygon import convex_pieces, polygon_area
 
 ROOT = Path(__file__).resolve().parent.parent
 SUITE = sorted(glob.glob(str(ROOT / "scenarios" / "*" / "*.yaml")))

@@ -61,14 +61,14 @@ def clip_simplices(simplices: NDArray, normal: NDArray, offset: float) -> NDArra
         sel = count == keep
         if not sel.any():
             continue
-        T, D, I = S[sel], d[sel], inside[sel]
+        T, D, keeps = S[sel], d[sel], inside[sel]
         # roll each simplex so that its inside corners come first (in cyclic order)
         if corners == 2:
-            first = np.where(I[:, 0], 0, 1)
+            first = np.where(keeps[:, 0], 0, 1)
         elif keep == 1:
-            first = np.argmax(I, axis=1)
+            first = np.argmax(keeps, axis=1)
         else:
-            first = np.argmin(I, axis=1) + 1  # the corner after the outside one
+            first = np.argmin(keeps, axis=1) + 1  # the corner after the outside one
         order = (first[:, None] + np.arange(corners)[None, :]) % corners
         T = np.take_along_axis(T, order[:, :, None], axis=1)
         D = np.take_along_axis(D, order, axis=1)

@@ -132,9 +132,7 @@ def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull
     import trimesh
 
     try:
-        loaded = trimesh.load(
-            io.BytesIO(data), file_type=suffix[1:], force="mesh", process=False
-        )
+        loaded = trimesh.load(io.BytesIO(data), file_type=suffix[1:], force="mesh", process=False)
     except Exception as err:  # trimesh raises many kinds on malformed files
         reason = str(err).splitlines()[0][:120] if str(err) else type(err).__name__
         raise SolidError(f"{source}: expected a readable {suffix} mesh, got: {reason}") from None
@@ -153,7 +151,9 @@ def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull
         try:
             mesh = mesh.convex_hull
         except Exception:
-            raise SolidError(f"{source}: expected a mesh spanning a solid, got a flat one") from None
+            raise SolidError(f"{source}: expected a mesh spanning a solid, got a flat one") from (
+                None
+            )
     elif not mesh.is_watertight:
         edges = trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)
         raise SolidError(

@@ -25,11 +25,11 @@ import yaml
 from numpy.typing import NDArray
 
 from kcplan.files import write_text_atomic
+from kcplan.geometry.polygon import convex_pieces
 from kcplan.geometry.pose import quaternion_matrix, wrap_angle
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.world.mesh import convex_hull, read_mesh
-from kcplan.geometry.polygon import convex_pieces
 
 __all__ = [
     "DEFAULT_INFLATION",
