@@ -22,7 +22,7 @@ from kcplan.world.mesh import convex_hull
 from kcplan.world.scenario import Obstacle, Scenario
 from kcplan.world.support import box_vertices
 
-__all__ = ["scene_figure", "write_scene_html"]
+__all__ = ["cover_figure", "scene_figure", "write_cover_html", "write_scene_html"]
 
 _SPHERE = convex_hull(unit_normals(3, 160))  # unit sphere: vertices and triangles
 
@@ -143,3 +143,33 @@ def write_scene_html(scenario: Scenario, path: str | os.PathLike, states=None) -
     works offline), atomically."""
     html = scene_figure(scenario, states).to_html(include_plotlyjs=True, full_html=True)
     write_text_atomic(path, html)
+
+
+def cover_figure(cover) -> go.Figure:
+    """A part (:class:`kcplan.cover.Cover`'s solid) and its bodies as a plotly figure."""
+    solid, robot = cover.solid, cover.robot
+    n = solid.dimension
+    if n == 2:
+        V = np.column_stack([solid.vertices, np.zeros(len(solid.vertices))])
+        from kcplan.geometry.polygon import convex_pieces
+
+        traces = [_mesh(*_flat(p), "#8c8c8c", 0.9, "part") for p in convex_pieces(V[:, :2])]
+        identity = np.zeros(3)
+    else:
+        traces = [_mesh(solid.vertices, solid.faces, "#8c8c8c", 1.0, "part")]
+        identity = np.array([0, 0, 0, 0, 0, 0, 1.0])
+    palette = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2")
+    for k, (R, t, a) in enumerate(body_shapes(robot, identity)):
+        traces.append(_mesh(*_ellipsoid(t, R, a, n), palette[k % 7], 0.3, f"body {k}"))
+    figure = go.Figure(data=traces)
+    figure.update_layout(
+        title=f"{solid.describe()}: {len(robot)} {cover.shape}s",
+        scene={"aspectmode": "data"},
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+    )
+    return figure
+
+
+def write_cover_html(cover, path: str | os.PathLike) -> None:
+    """Write :func:`cover_figure` as one self-contained HTML file, atomically."""
+    write_text_atomic(path, cover_figure(cover).to_html(include_plotlyjs=True, full_html=True))

@@ -33,6 +33,7 @@ __all__ = [
     "ellipse_outline",
     "ellipsoid_surface",
     "scenario_axes",
+    "plot_cover",
 ]
 
 
@@ -305,4 +306,57 @@ def plot_path(
                 ax.plot_wireframe(*surface, color="tab:orange", lw=0.3, alpha=0.5)
     extra = f", {len(guards)} guards (dashed)" if guards else ""
     ax.set_title((title or scenario.name) + extra, fontsize=9)
+    save_figure(fig, path)
+
+
+COVER_COLOURS = plt.get_cmap("tab10").colors
+
+
+def plot_cover(cover, path: str | os.PathLike, tightness: str = "") -> None:
+    """Draw a part and its cover (:class:`kcplan.cover.Cover`): the polygon and its
+    ellipses (2D), or the mesh and its ellipsoids from two viewpoints (3D)."""
+    solid, robot = cover.solid, cover.robot
+    identity = np.zeros(3) if solid.dimension == 2 else np.array([0, 0, 0, 0, 0, 0, 1.0])
+    shapes = list(body_shapes(robot, identity))
+    title = f"{solid.describe()}: {len(robot)} {cover.shape}s" + (
+        f", {tightness}" if tightness else ""
+    )
+    if solid.dimension == 2:
+        fig, ax = plt.subplots(figsize=(7, 6))
+        ax.fill(*solid.vertices.T, color="0.6", alpha=0.8, lw=0.8, ec="k", label="part")
+        for k, (R, t, a) in enumerate(shapes):
+            outline = ellipse_outline(t, R, a)
+            colour = COVER_COLOURS[k % len(COVER_COLOURS)]
+            ax.fill(*outline.T, color=colour, alpha=0.15)
+            ax.plot(*outline.T, color=colour, lw=1.2)
+        ax.set_aspect("equal")
+        ax.set_title(title, fontsize=9)
+        save_figure(fig, path)
+        return
+    fig = plt.figure(figsize=(12, 6))
+    corners = solid.vertices[solid.faces]
+    low, high = solid.vertices.min(axis=0), solid.vertices.max(axis=0)
+    for R, t, a in shapes:  # the bodies stick out of the part
+        half = np.sqrt(((R * a) ** 2).sum(axis=1))
+        low, high = np.minimum(low, t - half), np.maximum(high, t + half)
+    for i, (elev, azim) in enumerate(((25, -60), (85, -90))):
+        ax = fig.add_subplot(1, 2, i + 1, projection="3d")
+        ax.add_collection3d(
+            Poly3DCollection(corners, facecolor="0.55", edgecolor="0.3", linewidths=0.1)
+        )
+        for k, (R, t, a) in enumerate(shapes):
+            colour = COVER_COLOURS[k % len(COVER_COLOURS)]
+            ax.plot_wireframe(*ellipsoid_surface(t, R, a, 12), color=colour, lw=0.5, alpha=0.6)
+        ax.set_xlim(low[0], high[0])
+        ax.set_ylim(low[1], high[1])
+        ax.set_zlim(low[2], high[2])
+        ax.set_box_aspect(high - low)
+        ax.view_init(elev, azim)
+        ax.tick_params(labelsize=6)
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.set_major_locator(plt.MaxNLocator(3))
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_zlabel("z")
+    fig.suptitle(title, fontsize=10)
     save_figure(fig, path)

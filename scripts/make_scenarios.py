@@ -486,6 +486,46 @@ def icosahedron() -> tuple[np.ndarray, np.ndarray]:
     return V / np.linalg.norm(V[0]), T
 
 
+def l_bracket() -> tuple[np.ndarray, np.ndarray]:
+    """A CAD-like part: an L-shaped angle bracket 60 x 40 mm, 8 mm thick, 30 mm wide, in
+    metres, as a closed mesh (the L outline extruded; caps fanned over its convex pieces,
+    which share the outline's vertices, so the mesh is watertight)."""
+    from kcplan.geometry.polygon import convex_pieces
+
+    outline = np.array([[0, 0], [60, 0], [60, 8], [8, 8], [8, 40], [0, 40]], float) * 1e-3
+    k, width = len(outline), 0.03
+    V = np.vstack([np.column_stack([outline, np.zeros(k)]),
+                   np.column_stack([outline, np.full(k, width)])])  # fmt: skip
+    index = {tuple(p): i for i, p in enumerate(outline)}
+    T = []
+    for piece in convex_pieces(outline):
+        ids = [index[tuple(p)] for p in piece]
+        for i in range(1, len(ids) - 1):
+            T += [[ids[0], ids[i + 1], ids[i]], [k + ids[0], k + ids[i], k + ids[i + 1]]]
+    for i in range(k):
+        j = (i + 1) % k
+        T += [[i, j, k + j], [i, k + j, k + i]]
+    return V, np.array(T)
+
+
+def hand_through_slot() -> dict:
+    obstacles = slab_with_hole(-0.08, 0.08, -0.18, 0.18, -0.05, 0.07, -0.5, 0.5)
+    s = math.sin(math.pi / 4)
+    data = scenario(
+        "hand_through_slot",
+        "the Franka Panda hand's collision mesh (covered by 4 ellipsoids) passes a slot "
+        "0.36 x 0.12 m through a wall 0.16 m thick, starting and ending with its 0.2 m long axis upright",
+        3,
+        [-0.6, -0.5, -0.4],
+        [0.6, 0.5, 0.4],
+        pose3(-0.4, 0, 0, (s, 0, 0, s)),
+        pose3(0.4, 0, 0, (s, 0, 0, s)),
+        obstacles,
+    )
+    data["robot"] = {"mesh": "meshes/panda_hand.stl", "bodies": 4, "inflation": 0.1}
+    return data
+
+
 def open_space() -> dict:
     obstacles = [
         {"sphere": {"center": [30, 30, 25], "radius": 8}},
@@ -539,7 +579,7 @@ SUITE = {
         thin_wall,
         l_robot_door,
     ],
-    "3d": [window_wall, box_field, narrow_tunnel, peg_in_hole, open_space],
+    "3d": [window_wall, box_field, narrow_tunnel, peg_in_hole, open_space, hand_through_slot],
 }
 
 
@@ -553,6 +593,11 @@ def main() -> None:
     (out / "2d").mkdir(parents=True, exist_ok=True)
     V, T = icosahedron()
     write_stl(out / "3d" / "meshes" / "rock.stl", V, T)
+    write_stl(out / "3d" / "meshes" / "l_bracket.stl", *l_bracket())
+    hand = Path(__file__).resolve().parents[1] / "scenarios" / "3d" / "meshes"
+    for name in ("panda_hand.stl", "LICENSE-panda.txt"):  # committed data, not generated
+        if (out / "3d" / "meshes" / name).resolve() != (hand / name).resolve():
+            (out / "3d" / "meshes" / name).write_bytes((hand / name).read_bytes())
     for folder, makers in SUITE.items():
         for make in makers:
             data = make()

@@ -9,12 +9,22 @@ import os
 import sys
 from collections.abc import Sequence
 
-from kcplan.cli import bench, bounds, import_map, pick_place, plan, show, validate, verify
+from kcplan.cli import (
+    bench,
+    bounds,
+    import_map,
+    pick_place,
+    plan,
+    robot,
+    show,
+    validate,
+    verify,
+)
 from kcplan.cli.common import InputError, Parser
 
 __all__ = ["build_parser", "main"]
 
-SUBCOMMANDS = (bounds, validate, show, plan, verify, bench, pick_place, import_map)
+SUBCOMMANDS = (bounds, validate, show, plan, verify, bench, pick_place, import_map, robot)
 """Subcommand modules, in the order of ``kcplan --help``."""
 
 

@@ -50,20 +50,50 @@ def run(args: argparse.Namespace) -> int:
     from kcplan.planning.verify import verify_path
     from kcplan.world import CollisionWorld
 
-    check = verify_path(CollisionWorld(scenario), states, tolerance=args.tolerance)
+    world = CollisionWorld(scenario)
+    what = "the robot"
+    if args.mesh is not None:
+        world, what = _part_world(args, scenario, world)
+    check = verify_path(world, states, tolerance=args.tolerance)
     edges = max(len(states) - 1, 1)
     if check.collides:
         pose = ", ".join(f"{v:.6g}" for v in check.first_collision)
         print(
-            f"COLLISION on edge {check.edge_index} at s = {check.s:.6f}: pose [{pose}] "
-            f"({check.queries} clearance queries)"
+            f"COLLISION of {what} on edge {check.edge_index} at s = {check.s:.6f}: pose "
+            f"[{pose}] ({check.queries} clearance queries)"
         )
         return 1
     print(
-        f"clean: {edges} edges checked without gaps, minimum clearance "
+        f"clean: {what}, {edges} edges checked without gaps, minimum clearance "
         f"{check.min_clearance:.6g}, {check.queries} clearance queries"
     )
     return 0
+
+
+def _part_world(args: argparse.Namespace, scenario, world):
+    """The part of ``--mesh`` (the scenario's own mesh when given without a file)."""
+    from kcplan.world.part import PartWorld
+
+    if args.mesh == "":
+        if scenario.part is None:
+            raise InputError(
+                f"{args.scenario}: --mesh: expected a mesh file, or a scenario whose robot "
+                "is a mesh (robot.mesh); this robot is given as ellipsoids"
+            )
+        part = scenario.part
+    else:
+        from kcplan.cover import SolidError, read_solid
+
+        try:
+            part = read_solid(args.mesh, args.scale)
+        except SolidError as err:
+            raise InputError(str(err)) from None
+        if part.dimension != scenario.dimension:
+            raise InputError(
+                f"{args.mesh}: --mesh: expected a {scenario.dimension}D part like "
+                f"{args.scenario}, got {part.dimension}D"
+            )
+    return PartWorld(world, part), f"the part {part.describe()}"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -82,5 +112,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=positive_float,
         default=1e-6,
         help="clearance below which a pose counts as colliding (default 1e-6)",
+    )
+    p.add_argument(
+        "--mesh",
+        nargs="?",
+        const="",
+        metavar="MESH",
+        help="check the part's own mesh (or outline) instead of the robot's ellipsoids: "
+        "the scenario's robot.mesh, or the file given (in the robot's frame)",
+    )
+    p.add_argument(
+        "--scale",
+        type=positive_float,
+        default=1.0,
+        help="with --mesh MESH: multiply its coordinates (default 1)",
     )
     p.set_defaults(handler=run)

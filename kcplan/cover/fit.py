@@ -165,6 +165,11 @@ class _Scorer:
     def inside(self, center: NDArray, M: NDArray) -> NDArray[np.bool_]:
         return mahalanobis_sq(self.points, center, M) <= 1.0
 
+    def outside(self, M: NDArray, inside: NDArray[np.bool_]) -> float:
+        """Volume of an ellipsoid outside the sampled region (exact volume less the
+        sampled part), so that a cut cannot hide volume there."""
+        return max(0.0, ellipsoid_volume(M) - float(inside.sum()) * self.cell)
+
 
 def fit_cover(
     solid: Solid,
@@ -255,32 +260,36 @@ def fit_cover(
 
 
 def _candidates(solid: Solid, leaf: _Leaf, shape: str, scorer: _Scorer) -> list[tuple]:
-    """Candidate cuts of ``leaf`` as ``(normal, offset, inside_below | inside_above)``:
-    the sample points the two children's ellipsoids (fitted to their clipped boundary
-    points) hold."""
+    """Candidate cuts of ``leaf`` as ``(normal, offset, covered, outside)``: the sample
+    points the two children's ellipsoids (fitted to their clipped boundary points) hold,
+    and their volume outside the sampled region."""
     out = []
     V = leaf.piece.boundary_points
     for normal in _directions(leaf.M):
         for offset in np.unique(np.quantile(V @ normal, CUT_QUANTILES)):
             covered = np.zeros(len(scorer.points), dtype=bool)
+            outside = 0.0
             for sign in (1.0, -1.0):
                 part = leaf.piece.cut(sign * normal, sign * offset).boundary
                 if len(part) == 0:
                     break
                 c, M = _enclosing(part.reshape(-1, solid.dimension), shape, SEARCH_TOL)
-                covered |= scorer.inside(c, M)
+                inside = scorer.inside(c, M)
+                covered |= inside
+                outside += scorer.outside(M, inside)
             else:
-                out.append((normal, float(offset), covered))
+                out.append((normal, float(offset), covered, outside))
     return out
 
 
 def _best_cut(leaf: _Leaf, scorer: _Scorer, others: NDArray) -> tuple:
     """The candidate cut of ``leaf`` that leaves the smallest union: ``(gain, normal,
     offset)`` with the gain in volume units (may be negative)."""
-    base = int((others | scorer.inside(leaf.center, leaf.M)).sum())
+    inside = scorer.inside(leaf.center, leaf.M)
+    base = int((others | inside).sum()) * scorer.cell + scorer.outside(leaf.M, inside)
     best = (-np.inf, None, None)
-    for normal, offset, covered in leaf.candidates:
-        gain = (base - int((others | covered).sum())) * scorer.cell
+    for normal, offset, covered, outside in leaf.candidates:
+        gain = base - int((others | covered).sum()) * scorer.cell - outside
         if gain > best[0]:
             best = (gain, normal, offset)
     return best

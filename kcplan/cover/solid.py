@@ -155,10 +155,12 @@ def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull
                 None
             )
     elif not mesh.is_watertight:
-        edges = trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)
+        _, counts = np.unique(mesh.edges_sorted, axis=0, return_counts=True)
+        open_edges, shared = int((counts == 1).sum()), int((counts > 2).sum())
         raise SolidError(
-            f"{source}: expected a closed (watertight) mesh, got one with {len(edges)} "
-            "open edges; pass --hull to cover its convex hull instead"
+            f"{source}: expected a closed (watertight) mesh, got one with {open_edges} open "
+            f"edges and {shared} edges shared by more than two triangles; "
+            "pass --hull to cover its convex hull instead"
         )
     if not mesh.is_winding_consistent:
         trimesh.repair.fix_winding(mesh)  # reorders corners only

@@ -7,6 +7,11 @@ reach times rotation angle change; the reach is the largest distance of a point 
 body from the robot's origin, :attr:`kcplan.geometry.robot.Robot.reach`). Stepping by
 ``d / sweep_speed`` therefore covers each edge without gaps, however thin the obstacles,
 using only FCL clearances (the minimum over bodies).
+
+The same walk checks a robot's own part (:class:`kcplan.world.part.PartWorld`, ``kcplan
+verify --mesh``): any world with ``dimension``, ``reach`` and ``safe_clearance(pose)``
+will do, and one with ``encloses_obstacle(pose)`` is also asked whether an obstacle lies
+wholly inside the robot at the first pose (a surface cannot see it there).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from numpy.typing import ArrayLike
 
 from kcplan.geometry.pose import Edge
 from kcplan.world.collision import CollisionWorld
+from kcplan.world.part import PartWorld
 
 __all__ = ["PathCheck", "verify_path"]
 
@@ -41,13 +47,17 @@ class PathCheck:
 
 
 def verify_path(
-    world: CollisionWorld, states: ArrayLike, tolerance: float = 1e-6, max_queries: int = 10**6
+    world: CollisionWorld | PartWorld,
+    states: ArrayLike,
+    tolerance: float = 1e-6,
+    max_queries: int = 10**6,
 ) -> PathCheck:
     """Check every edge of a path, interpolated as OMPL does, without gaps.
 
     Parameters
     ----------
-    world : CollisionWorld
+    world : CollisionWorld or PartWorld
+        The robot's ellipsoids, or its own part, against the obstacles.
     states : array_like, shape (k, 3 or 7)
         Flat poses of the path's waypoints.
     tolerance : float
@@ -57,10 +67,13 @@ def verify_path(
         Safety limit; exceeding it is reported as a collision (not proven free).
     """
     P = np.asarray(states, dtype=float)
-    n, radius = world.dimension, world.robot.reach
+    n, radius = world.dimension, world.reach
     queries, lowest = 0, np.inf
     if len(P) == 1:
         P = np.vstack([P, P])
+    enclosed = getattr(world, "encloses_obstacle", None)
+    if enclosed is not None and enclosed(P[0]):
+        return PathCheck(True, 0.0, 0, 0, 0.0, P[0].tolist())
     for k in range(len(P) - 1):
         edge = Edge(P[k], P[k + 1], n)
         speed = edge.sweep_speed(radius)

@@ -40,7 +40,7 @@ from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario
 from kcplan.world.support import box_vertices, piece_supports
 
-__all__ = ["CLEARANCE_RTOL", "CLEARANCE_ATOL", "CollisionWorld"]
+__all__ = ["CLEARANCE_RTOL", "CLEARANCE_ATOL", "CollisionWorld", "polygon_prism"]
 
 CLEARANCE_RTOL = 2e-3
 """Relative error allowed for FCL's iterative (GJK) distances. FCL *over*-estimates
@@ -53,8 +53,9 @@ largest side of the bounds): near contact the excess is absolute (4.5e-6 at dist
 6.6e-5 between an ellipsoid and a 1000-wide box, in a scene 200 wide)."""
 
 
-def _prism(polygon: NDArray, half_height: float) -> fcl.Convex:
-    """Convex prism over a convex CCW polygon, ``|z| <= half_height``."""
+def polygon_prism(polygon: NDArray, half_height: float) -> fcl.Convex:
+    """The convex prism over a convex CCW polygon, ``|z| <= half_height``: how a planar
+    convex piece is given to FCL (see the module docstring)."""
     k = len(polygon)
     V = np.vstack(
         [
@@ -200,7 +201,7 @@ class CollisionWorld:
         n, identity = self.dimension, fcl.Transform()
         center3 = np.append(ob.center, 0.0) if n == 2 else ob.center
         if ob.kind in ("polygon", "box") and n == 2:
-            return [(_prism(p, self._half_height), identity) for p in ob.pieces]
+            return [(polygon_prism(p, self._half_height), identity) for p in ob.pieces]
         if ob.kind == "box":
             if np.allclose(ob.rotation, np.eye(3)):
                 return [(fcl.Box(*(2 * ob.extents)), fcl.Transform(center3))]
@@ -319,6 +320,29 @@ class CollisionWorld:
         ``clearance_atol = CLEARANCE_ATOL * scene size`` (one distance query)."""
         d = self.body_clearances(pose)
         return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+
+    def object_clearance(self, obj: fcl.CollisionObject) -> float:
+        """Distance from any FCL object, placed by the caller, to the nearest obstacle,
+        reduced by FCL's error allowance as in :meth:`safe_body_clearances` (one distance
+        query; ``inf`` without obstacles). :mod:`kcplan.world.part` measures a robot's
+        own mesh with it."""
+        self._fcl_counters["distance_queries"] += 1
+        if not self._objects:
+            return math.inf
+        data = fcl.DistanceData()
+        self._manager.distance(obj, data, fcl.defaultDistanceCallback)
+        d = max(float(data.result.min_distance), 0.0)
+        return max(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+
+    @property
+    def half_height(self) -> float:
+        """Half height of the prisms that stand for planar obstacles in FCL (2D)."""
+        return self._half_height
+
+    @property
+    def reach(self) -> float:
+        """:attr:`kcplan.geometry.robot.Robot.reach` of the robot queried."""
+        return self.robot.reach
 
     def safe_clearance(self, pose: ArrayLike) -> float:
         """The minimum of :meth:`safe_body_clearances` (one distance query)."""

@@ -59,6 +59,8 @@ MAX_MAGNITUDE = 1e9
 """Largest absolute value of any number in a scenario; FCL crashes on values near 1e300."""
 MIN_POSITIVE = 1e-9
 """Smallest size (side, semi-axis, radius, scale, inflation) accepted."""
+DEFAULT_COVER_BODIES = 4
+"""Bodies of the cover of ``robot.mesh`` when ``robot.bodies`` is absent."""
 QUATERNION_TOLERANCE = 1e-2
 """Quaternions with | |q| - 1 | up to this are normalised; larger deviations are errors."""
 
@@ -135,6 +137,9 @@ class Scenario:
     description: str = ""
     source: str = "<string>"
     directory: Path = field(default_factory=Path.cwd)
+    part: Any = None
+    """The robot's own part (:class:`kcplan.cover.Solid`) when the robot is the cover of
+    a mesh (``robot: {mesh: ...}``), else None; ``kcplan verify --mesh`` checks it."""
 
     @property
     def semi_axes(self) -> NDArray[np.float64]:
@@ -295,15 +300,53 @@ class _Reader:
         return np.concatenate([position, q])
 
 
-def _robot(r: _Reader, value: Any, n: int) -> tuple[Robot, float]:
-    """The ``robot`` mapping: the robot (``semi_axes``: one body at the origin, or
-    ``bodies``) and its guard inflation."""
-    spec = r.mapping(value, "robot", (), ("semi_axes", "bodies", "inflation"))
-    if ("semi_axes" in spec) == ("bodies" in spec):
-        r.fail("robot", "exactly one of semi_axes (one body) and bodies (a list)", value)
+def _mesh_robot(r: _Reader, spec: dict, n: int, directory: Path) -> tuple[Robot, Any]:
+    """``robot: {mesh: FILE, bodies: K, scale: S, hull: false}``: the cover of the part
+    (:func:`kcplan.cover.cache.cached_cover`) and the part itself."""
+    from kcplan.cover.cache import cached_cover
+    from kcplan.cover.solid import SolidError
+
+    name = r.text(spec["mesh"], "robot.mesh")
+    path = (directory / name).resolve()
+    if not path.is_file():
+        r.fail("robot.mesh", "an existing mesh or outline file (relative to the scenario)",
+               name, f"{name!r}, which does not exist at {path}")  # fmt: skip
+    count = spec.get("bodies", DEFAULT_COVER_BODIES)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_BODIES:
+        r.fail("robot.bodies", f"an integer 1 to {MAX_BODIES} (the cover's bodies)", count)
+    scale = r.number(spec.get("scale", 1.0), "robot.scale", positive=True)
+    hull = spec.get("hull", False)
+    if not isinstance(hull, bool):
+        r.fail("robot.hull", "true or false", hull)
+    try:
+        cover, _ = cached_cover(path, count, scale, hull=hull)
+    except SolidError as err:
+        raise ScenarioError(f"{r.source}: robot.mesh: {err}") from None
+    if cover.solid.dimension != n:
+        r.fail("robot.mesh", f"a {n}D part", name, f"{name!r}, a {cover.solid.dimension}D part")
+    return cover.robot, cover.solid
+
+
+def _robot(r: _Reader, value: Any, n: int, directory: Path) -> tuple[Robot, float, Any]:
+    """The ``robot`` mapping: the robot (``semi_axes``: one body at the origin,
+    ``bodies``, or a ``mesh`` to cover), its guard inflation and the mesh's part (or
+    None)."""
+    spec = r.mapping(value, "robot", (), ("semi_axes", "bodies", "mesh", "scale", "hull",
+                                          "inflation"))  # fmt: skip
     inflation = r.number(spec.get("inflation", DEFAULT_INFLATION), "robot.inflation", True)
+    if "mesh" in spec:
+        if "semi_axes" in spec:
+            r.fail("robot", "semi_axes or mesh, not both", value)
+        robot, part = _mesh_robot(r, spec, n, directory)
+        return robot, inflation, part
+    for key in ("scale", "hull"):
+        if key in spec:
+            raise ScenarioError(f"{r.source}: robot.{key}: only allowed with robot.mesh")
+    if ("semi_axes" in spec) == ("bodies" in spec):
+        r.fail("robot", "exactly one of semi_axes (one body), bodies (a list) and mesh", value)
     if "semi_axes" in spec:
-        return Robot.single(r.vector(spec["semi_axes"], "robot.semi_axes", n, True)), inflation
+        axes = r.vector(spec["semi_axes"], "robot.semi_axes", n, True)
+        return Robot.single(axes), inflation, None
     items = spec["bodies"]
     if not isinstance(items, list) or not items or len(items) > MAX_BODIES:
         r.fail("robot.bodies", f"a list of 1 to {MAX_BODIES} bodies", items)
@@ -315,7 +358,7 @@ def _robot(r: _Reader, value: Any, n: int) -> tuple[Robot, float]:
         axes = r.vector(body["semi_axes"], f"{where}.semi_axes", n, positive=True)
         pose = r.pose({"position": [0.0] * n} | body, where, n, ignore=("semi_axes",))
         bodies.append(Body(axes, pose))
-    return Robot(bodies), inflation
+    return Robot(bodies), inflation, None
 
 
 def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Obstacle:
@@ -431,7 +474,7 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
     low, high = r.vector(b["low"], "bounds.low", n), r.vector(b["high"], "bounds.high", n)
     if not (low < high).all():
         r.fail("bounds", "low < high in every coordinate", top["bounds"])
-    robot, inflation = _robot(r, top["robot"], n)
+    robot, inflation, part = _robot(r, top["robot"], n, directory)
     poses = {}
     for key in ("start", "goal"):
         pose = r.pose(top[key], key, n)
@@ -462,6 +505,7 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
         description,
         source,
         directory,
+        part,
     )
     return scenario
 

@@ -1,0 +1,131 @@
+"""``kcplan robot fit``: a robot of ellipsoids that provably contains a mesh or outline."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import yaml
+
+from kcplan.cli.common import InputError, output_file, positive_float, positive_int
+
+TIGHTNESS_SAMPLES = 400_000
+"""Monte Carlo samples of the reported volume ratio."""
+
+
+def _robot_yaml(cover, ratio: float, error: float) -> str:
+    solid = cover.solid
+    header = (
+        f"# kcplan robot fit: {len(cover.bodies)} {cover.shape}s covering {solid.describe()}\n"
+        f"# sha256 {solid.digest}\n"
+        f"# union volume / part volume {ratio:.4f} +- {error:.4f} (95 %, Monte Carlo)\n"
+    )
+    body = yaml.safe_dump({"robot": cover.to_spec()}, sort_keys=False, default_flow_style=None)
+    return header + body
+
+
+def run_fit(args: argparse.Namespace) -> int:
+    """Fit, report the tightness, write the robot block, the picture and the view."""
+    output_file(args.output, "-o", (".yaml", ".yml"))
+    output_file(args.plot, "--plot", (".png", ".svg", ".pdf"))
+    output_file(args.html, "--html", (".html",))
+    from kcplan.cover import SolidError, fit_cover, read_solid, union_volume
+    from kcplan.geometry.robot import MAX_BODIES
+
+    if args.bodies is not None and args.bodies > MAX_BODIES:
+        raise InputError(f"--bodies: expected 1 to {MAX_BODIES}, got {args.bodies}")
+    try:
+        solid = read_solid(args.mesh, args.scale, args.hull)
+    except SolidError as err:
+        raise InputError(str(err)) from None
+    report = sys.stdout if args.output else sys.stderr  # without -o the YAML goes to stdout
+    shape = "sphere" if args.spheres else "ellipsoid"
+    bodies = None if args.max_excess is not None else (args.bodies or 4)
+
+    def progress(line: str) -> None:
+        print(f"  {line}", file=sys.stderr, flush=True)
+
+    cover = fit_cover(solid, bodies, args.max_excess, shape, progress)
+    volume, error = union_volume(cover.bodies, TIGHTNESS_SAMPLES)
+    ratio, error95 = volume / solid.volume, 1.96 * error / solid.volume
+    unit = "area" if solid.dimension == 2 else "volume"
+    print(
+        f"{solid.describe()}, {unit} {solid.volume:.6g}: {len(cover.bodies)} {shape}s in "
+        f"{cover.seconds:.1f} s",
+        file=report,
+    )
+    print(
+        f"  union {unit} / part {unit}: {ratio:.4f} +- {error95:.4f} (95 %, Monte Carlo, "
+        f"{TIGHTNESS_SAMPLES} samples); the bodies' total: {cover.volume_bound:.4f}",
+        file=report,
+    )
+    print(
+        f"  sound: every hull point of every piece inside its body "
+        f"(largest (x-p)^T M (x-p) = {cover.worst:.10f})",
+        file=report,
+    )
+    if cover.note:
+        print(f"  {cover.note}", file=report)
+    text = _robot_yaml(cover, ratio, error95)
+    if args.output:
+        from kcplan.files import write_text_atomic
+
+        write_text_atomic(args.output, text)
+        print(f"robot written to {args.output}")
+    else:
+        sys.stdout.write(text)
+    tightness = f"union / part {ratio:.3f}"
+    if args.plot:
+        from kcplan.viz import plot_cover
+
+        plot_cover(cover, args.plot, tightness)
+        print(f"picture written to {args.plot}", file=report)
+    if args.html:
+        from kcplan.html_view import write_cover_html
+
+        write_cover_html(cover, args.html)
+        print(f"interactive view written to {args.html}", file=report)
+    return 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """Register ``kcplan robot`` (with its action ``fit``) on the subcommand parsers."""
+    p = sub.add_parser(
+        "robot",
+        help="make robots: fit ellipsoids that contain a mesh or outline",
+        description="Robots for kcplan scenarios.",
+    )
+    actions = p.add_subparsers(dest="action", required=True, parser_class=type(p))
+    fit = actions.add_parser(
+        "fit",
+        help="cover a mesh (3D) or a polygon (2D) by ellipsoids that provably contain it",
+        description="Cover a closed mesh (STL, OBJ, PLY, OFF, glTF) or a simple polygon (YAML "
+        "list of [x, y], or CSV x,y rows) by K ellipsoids (ellipses) whose union provably "
+        "contains it, and write them as a scenario's robot block (in the mesh's frame and "
+        "unit times --scale). Exit 0 done, 2 bad input.",
+    )
+    fit.add_argument("mesh", metavar="MESH", help="mesh or outline file")
+    count = fit.add_mutually_exclusive_group()
+    count.add_argument(
+        "--bodies", type=positive_int, metavar="K", help="number of bodies (default 4)"
+    )
+    count.add_argument(
+        "--max-excess",
+        type=positive_float,
+        metavar="X",
+        help="instead of --bodies: the fewest bodies whose total volume is at most (1 + X) "
+        "times the part's",
+    )
+    fit.add_argument(
+        "--scale", type=positive_float, default=1.0, help="multiply coordinates (default 1)"
+    )
+    fit.add_argument(
+        "--hull",
+        action="store_true",
+        help="cover the mesh's convex hull (for meshes that are not closed)",
+    )
+    fit.add_argument("--spheres", action="store_true", help="fit spheres instead (for comparison)")
+    fit.add_argument("-o", "--output", metavar="ROBOT.yaml", help="write the robot block here")
+    fit.add_argument("--plot", metavar="FILE.png", help="draw the part and its cover")
+    fit.add_argument("--html", metavar="FILE.html", help="write an interactive 3D view")
+    fit.set_defaults(handler=run_fit)

@@ -1,0 +1,111 @@
+"""A per-user cache of fitted covers, so that a scenario naming a mesh fits it once.
+
+Entries live in ``$KCPLAN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/kcplan/covers``, else
+``~/.cache/kcplan/covers``), one JSON file per key: the SHA-256 of the mesh file's bytes
+and of the fit's parameters (bodies, scale, shape, hull, :data:`kcplan.cover.fit.FIT_VERSION`).
+An entry is never trusted: its bodies and cutting tree are re-derived and checked
+against the mesh (:func:`kcplan.cover.fit.check_cover`, the same hull points as the fit),
+and a stale, corrupt or failing entry is refitted and replaced. A cache folder that
+cannot be written is not an error; the cover is then fitted every time.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from kcplan.cover.fit import FIT_VERSION, Cover, check_cover, fit_cover
+from kcplan.cover.solid import Solid, read_solid
+from kcplan.files import write_text_atomic
+from kcplan.geometry.robot import MAX_BODIES, Body
+
+__all__ = ["cache_folder", "cached_cover"]
+
+
+def cache_folder() -> Path:
+    """Where covers are cached (see the module docstring)."""
+    if os.environ.get("KCPLAN_CACHE_DIR"):
+        return Path(os.environ["KCPLAN_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(Path.home(), ".cache")
+    return Path(base) / "kcplan" / "covers"
+
+
+def _key(solid: Solid, bodies: int, scale: float, shape: str, hull: bool) -> str:
+    params = {"file": solid.digest, "bodies": bodies, "scale": scale, "shape": shape}
+    params |= {"hull": hull, "version": FIT_VERSION}
+    return hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()
+
+
+def _body(spec: dict, n: int) -> Body:
+    a = np.asarray(spec["semi_axes"], dtype=float)
+    p = np.asarray(spec["position"], dtype=float)
+    turn = np.asarray([spec["yaw"]] if n == 2 else spec["quaternion"], dtype=float)
+    if a.shape != (n,) or p.shape != (n,) or turn.shape != ((1,) if n == 2 else (4,)):
+        raise ValueError("body: wrong shapes")
+    if not (np.isfinite(a).all() and (a > 0).all() and np.isfinite(p).all()):
+        raise ValueError("body: expected finite positive semi-axes")
+    if n == 3:
+        norm = float(np.linalg.norm(turn))
+        if not abs(norm - 1.0) < 1e-9:
+            raise ValueError("body: expected a unit quaternion")
+        turn = turn / norm
+    return Body(a, np.concatenate([p, turn]))
+
+
+def _load(file: Path, key: str, solid: Solid, shape: str) -> Cover:
+    data = json.loads(file.read_text())
+    if data.get("key") != key:
+        raise ValueError("key: another fit")
+    specs = data["bodies"]
+    if not isinstance(specs, list) or not 1 <= len(specs) <= MAX_BODIES:
+        raise ValueError("bodies: expected a list")
+    bodies = tuple(_body(s, solid.dimension) for s in specs)
+    worst = check_cover(solid, data["tree"], bodies)
+    if not worst < 1.0:
+        raise ValueError("bodies: a hull point lies outside its body")
+    return Cover(solid, bodies, data["tree"], shape, 0.0, str(data.get("note", "")), worst)
+
+
+def cached_cover(
+    path: str | os.PathLike,
+    bodies: int,
+    scale: float = 1.0,
+    shape: str = "ellipsoid",
+    hull: bool = False,
+) -> tuple[Cover, str]:
+    """The cover of the part in ``path`` by ``bodies`` bodies, from the cache if a valid
+    entry exists, else fitted (and stored).
+
+    Returns
+    -------
+    cover : Cover
+    origin : str
+        ``cached``, ``fitted`` or ``refitted`` (an entry existed but failed its check).
+
+    Raises
+    ------
+    kcplan.cover.SolidError
+        For a part that cannot be read or covered.
+    """
+    solid = read_solid(path, scale, hull)
+    key = _key(solid, bodies, scale, shape, hull)
+    file = cache_folder() / f"{key}.json"
+    origin = "fitted"
+    if file.is_file():
+        try:
+            return _load(file, key, solid, shape), "cached"
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            origin = "refitted"
+    cover = fit_cover(solid, bodies=bodies, shape=shape)
+    entry = {"key": key, "source": os.fspath(path), "note": cover.note}
+    entry |= {"bodies": cover.to_spec()["bodies"], "tree": cover.tree}
+    try:
+        file.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(file, json.dumps(entry))
+    except OSError:
+        pass  # an unwritable cache only costs time
+    return cover, origin
