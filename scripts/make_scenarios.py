@@ -514,7 +514,8 @@ def hand_through_slot() -> dict:
     data = scenario(
         "hand_through_slot",
         "the Franka Panda hand's collision mesh (covered by 4 ellipsoids) passes a slot "
-        "0.36 x 0.12 m through a wall 0.16 m thick, starting and ending with its 0.2 m long axis upright",
+        "0.36 x 0.12 m through a wall 0.16 m thick, starting and ending with its 0.2 m "
+        "long axis upright",
         3,
         [-0.6, -0.5, -0.4],
         [0.6, 0.5, 0.4],
