@@ -1,4 +1,7 @@
-"""Shared hypothesis strategies for the geometry tests."""
+"""Shared hypothesis strategies for the geometry tests, and a private cover cache."""
+
+import os
+import tempfile
 
 import numpy as np
 from hypothesis import settings
@@ -6,6 +9,9 @@ from hypothesis import strategies as st
 
 settings.register_profile("default", deadline=None, print_blob=True)
 settings.load_profile("default")
+
+# covers of mesh robots are cached per user; the tests keep theirs apart (and start cold)
+os.environ["KCPLAN_CACHE_DIR"] = tempfile.mkdtemp(prefix="kcplan-test-cache-")
 
 
 @st.composite

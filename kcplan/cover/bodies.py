@@ -14,12 +14,19 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from kcplan.geometry.enclosing import ellipsoid_axes, mahalanobis_sq
+from kcplan.geometry.enclosing import ellipsoid_axes, frame_norm_sq
 from kcplan.geometry.pose import quaternion_matrix
 from kcplan.geometry.robot import Body
 from kcplan.geometry.rotations import exp_rotation
 
-__all__ = ["body_from_ellipsoid", "body_matrix", "body_holds", "inside_union", "union_volume"]
+__all__ = [
+    "body_from_ellipsoid",
+    "body_holds",
+    "body_matrix",
+    "body_rotation",
+    "inside_union",
+    "union_volume",
+]
 
 
 def body_from_ellipsoid(center: ArrayLike, M: ArrayLike, sphere: bool = False) -> Body:
@@ -33,21 +40,30 @@ def body_from_ellipsoid(center: ArrayLike, M: ArrayLike, sphere: bool = False) -
     if n == 2:
         pose = np.append(c, math.atan2(R[1, 0], R[0, 0]))
     else:
-        pose = np.concatenate([c, Rotation.from_matrix(R).as_quat()])  # [x, y, z, w]
+        q = Rotation.from_matrix(R).as_quat()  # [x, y, z, w]
+        pose = np.concatenate([c, q / np.linalg.norm(q)])
     return Body(a, pose)
 
 
 def body_matrix(body: Body) -> NDArray[np.float64]:
     """The shape matrix ``M = R diag(1 / a^2) R^T`` of a body, shape ``(n, n)``."""
-    n = body.dimension
-    R = exp_rotation([body.pose[2]], 2) if n == 2 else quaternion_matrix(body.pose[3:])
+    R = body_rotation(body)
     return R @ np.diag(1.0 / body.semi_axes**2) @ R.T
 
 
+def body_rotation(body: Body) -> NDArray[np.float64]:
+    """The body's orientation ``R`` in the robot frame, from its stored yaw or quaternion."""
+    return (
+        exp_rotation([body.pose[2]], 2) if body.dimension == 2 else quaternion_matrix(body.pose[3:])
+    )
+
+
 def body_holds(body: Body, points: ArrayLike) -> float:
-    """The largest ``(x - p)^T M (x - p)`` of the points: at most 1 when the body holds
-    them all."""
-    return float(mahalanobis_sq(points, body.position, body_matrix(body)).max())
+    """The largest ``|diag(1/a) R^T (x - p)|^2`` of the points, in the body's own frame as
+    stored (semi-axes, position, yaw or quaternion): at most 1 when the body holds them
+    all."""
+    X = np.asarray(points, dtype=float) - body.position
+    return float(frame_norm_sq(X, body.semi_axes, body_rotation(body)).max())
 
 
 def inside_union(points: ArrayLike, bodies: tuple[Body, ...] | list[Body]) -> NDArray[np.bool_]:
@@ -55,7 +71,7 @@ def inside_union(points: ArrayLike, bodies: tuple[Body, ...] | list[Body]) -> ND
     P = np.asarray(points, dtype=float)
     out = np.zeros(len(P), dtype=bool)
     for body in bodies:
-        out |= mahalanobis_sq(P, body.position, body_matrix(body)) <= 1.0
+        out |= frame_norm_sq(P - body.position, body.semi_axes, body_rotation(body)) <= 1.0
     return out
 
 

@@ -38,8 +38,9 @@ __all__ = ["Piece", "clip_simplices", "clip_points"]
 
 INSIDE_WINDING = 0.25
 """Cell corners whose winding number exceeds this in magnitude count as inside the solid.
-Inside is 1, outside 0 and the boundary itself 1/2; erring towards inside only adds
-points, which is always sound."""
+Inside is 1 and outside 0; erring towards inside only adds points, which is always sound.
+A corner exactly on the boundary may read either way, and needs no test: it is a corner
+of the clipped simplex it lies on, so clipping supplies it."""
 
 
 def clip_simplices(simplices: NDArray, normal: NDArray, offset: float) -> NDArray:

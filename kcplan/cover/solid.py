@@ -164,7 +164,8 @@ def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull
         )
     if not mesh.is_winding_consistent:
         trimesh.repair.fix_winding(mesh)  # reorders corners only
-    volume = float(mesh.volume)
+    with np.errstate(invalid="ignore", divide="ignore"):  # trimesh divides by a 0 volume
+        volume = float(mesh.volume)
     if volume < 0:
         mesh.invert()
         volume = -volume

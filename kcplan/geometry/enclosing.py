@@ -25,19 +25,33 @@ __all__ = [
     "ellipsoid_axes",
     "ellipsoid_volume",
     "enclose",
+    "frame_norm_sq",
     "mahalanobis_sq",
     "minimum_volume_ellipsoid",
 ]
 
-FLAT_RATIO = 1e-9
+FLAT_RATIO = 1e-6
 """Point sets whose thinnest principal spread is below this fraction of the widest are
 treated as flat (Khachiyan's iteration needs a full-dimensional set)."""
 
 
 def mahalanobis_sq(points: ArrayLike, center: ArrayLike, M: ArrayLike) -> NDArray[np.float64]:
-    """``(x - c)^T M (x - c)`` of every point, shape ``(m,)``: at most 1 inside ``E``."""
+    """``(x - c)^T M (x - c)`` of every point, shape ``(m,)``: at most 1 inside ``E``.
+
+    Computed as ``|diag(1/a) R^T (x - c)|^2`` in the ellipsoid's own frame: the product
+    with ``M`` itself cancels badly when ``M`` is ill-conditioned (an error of 1e-8 at an
+    axis ratio of 1e-6), the frame's rotation does not (about ``eps a_max / a_min``).
+    """
     X = np.asarray(points, dtype=float) - np.asarray(center, dtype=float)
-    return np.einsum("mi,ij,mj->m", X, np.asarray(M, dtype=float), X)
+    a, R = ellipsoid_axes(M)
+    return frame_norm_sq(X, a, R)
+
+
+def frame_norm_sq(X: ArrayLike, a: ArrayLike, R: ArrayLike) -> NDArray[np.float64]:
+    """``|diag(1/a) R^T x|^2`` of every row ``x`` of ``X`` ``(m, n)``: at most 1 for the
+    points of the ellipsoid with semi-axes ``a`` and orientation ``R`` about the origin."""
+    Y = (np.asarray(X, dtype=float) @ np.asarray(R, dtype=float)) / np.asarray(a, dtype=float)
+    return np.einsum("mi,mi->m", Y, Y)
 
 
 def ellipsoid_volume(M: ArrayLike) -> float:
@@ -63,7 +77,7 @@ def _flat_ellipsoid(P: NDArray) -> tuple[NDArray, NDArray]:
     """An ellipsoid around the principal box of a (nearly) flat point set, with the thin
     axes given a thickness of :data:`FLAT_RATIO` of the widest (enclose() finishes it)."""
     c = 0.5 * (P.min(axis=0) + P.max(axis=0))
-    _, _, Vt = np.linalg.svd(P - c, full_matrices=False)
+    _, _, Vt = np.linalg.svd(P - c)  # full: a basis even for fewer points than n
     local = (P - c) @ Vt.T
     mid = 0.5 * (local.min(axis=0) + local.max(axis=0))
     half = 0.5 * np.ptp(local, axis=0)
@@ -149,5 +163,6 @@ def enclose(
     """
     M = np.asarray(M, dtype=float)
     worst = float(mahalanobis_sq(points, center, M).max())
-    s2 = max(worst, 1e-300) * (1.0 + margin) ** 2
-    return M / s2
+    if worst == 0.0:  # every point at the centre: E already holds them, with any size
+        return M.copy()
+    return M / (worst * (1.0 + margin) ** 2)

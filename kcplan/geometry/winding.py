@@ -3,9 +3,12 @@
 The winding number of a point ``p`` with respect to a closed, consistently oriented
 boundary is the signed number of times the boundary wraps around ``p``: the sum of the
 signed angles (2D, edges) or solid angles (3D, triangles) that its pieces subtend at
-``p``, over ``2 pi`` or ``4 pi``. It is ``+-1`` inside a simple solid, 0 outside, and
-``+-1/2`` on the boundary itself, and it needs no ray casting (no special cases for rays
-through vertices). The solid angle of a triangle is Van Oosterom and Strackee's formula
+``p``, over ``2 pi`` or ``4 pi``. It is ``+-1`` inside a simple solid and 0 outside,
+however close to the boundary, and it needs no ray casting (no special cases for rays
+through vertices). *On* the boundary it is undefined: about 1/2 on a triangle's face, 0,
+1/2 or 1 on a polygon's edge, depending on the sign of a rounded zero.
+
+The solid angle of a triangle is Van Oosterom and Strackee's formula
 ("The solid angle of a plane triangle", IEEE Trans. Biomed. Eng. 30, 1983)::
 
     tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a . b)|c| + (b . c)|a| + (c . a)|b|)
