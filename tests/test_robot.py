@@ -231,7 +231,7 @@ def load_scenario_text(tmp_path, robot):
         ),
         (
             {"semi_axes": [1, 1], "bodies": [{"semi_axes": [1, 1]}]},
-            "robot: expected exactly one of semi_axes (one body) and bodies (a list)",
+            "robot: expected exactly one of semi_axes (one body), bodies (a list) and mesh",
         ),
         ({"inflation": 0.1}, "robot: expected exactly one of semi_axes"),
         (

@@ -105,6 +105,18 @@ CASES = [
         check=_coal_report,
     ),
     Case(
+        "cover_tightness.py",
+        ("--meshes", "scenarios/3d/meshes/l_bracket.stl", "--bodies", "1,2", "--samples")
+        + ("20000", "--timing", "1", "--timing-mesh", "scenarios/3d/meshes/rock.stl")
+        + ("--out", "{tmp}"),
+        (
+            rf"^\| meshes/l_bracket\.stl \| 20 \| 2 \| {NUMBER} \+- {NUMBER} \| {NUMBER} "
+            rf"\+- {NUMBER} \| {NUMBER} \| {NUMBER} \|$",
+            rf"^\| meshes/rock\.stl x16 \| 320 \| 1 \| {NUMBER} \|$",
+        ),
+        ("cover.md", "cover.csv", "cover.png"),
+    ),
+    Case(
         "compare_validators.py",
         (CORRIDOR, "--runs", "1", "--time", "2"),
         tuple(
@@ -158,6 +170,15 @@ CASES = [
             ("kernel", "kc-rrtconnect", "rrtconnect"),
             ("python", "kc-rrtconnect-py", "rrtconnect-fcl"),
         )
+    ),
+    Case(
+        "mesh_robot_paths.py",
+        ("--runs", "1", "--time", "5", "--planners", "kc-rrtconnect"),
+        (
+            r"4 ellipsoids covering panda_hand\.stl",
+            rf"^\| kc-rrtconnect \| 1/1 \| {NUMBER} "
+            rf"\| {NUMBER} \| 0 \| 0 \| {NUMBER} \|$",
+        ),  # fmt: skip
     ),
     Case(
         "own_setup_example.py",

@@ -51,20 +51,22 @@ def run(args: argparse.Namespace) -> int:
     from kcplan.world import CollisionWorld
 
     world = CollisionWorld(scenario)
-    what = "the robot"
+    part = ""  # names the part in the report when --mesh checks it
     if args.mesh is not None:
-        world, what = _part_world(args, scenario, world)
+        world, part = _part_world(args, scenario, world)
     check = verify_path(world, states, tolerance=args.tolerance)
     edges = max(len(states) - 1, 1)
     if check.collides:
         pose = ", ".join(f"{v:.6g}" for v in check.first_collision)
         print(
-            f"COLLISION of {what} on edge {check.edge_index} at s = {check.s:.6f}: pose "
+            f"COLLISION{f' of {part}' if part else ''} on edge {check.edge_index} at "
+            f"s = {check.s:.6f}: pose "
             f"[{pose}] ({check.queries} clearance queries)"
         )
         return 1
     print(
-        f"clean: {what}, {edges} edges checked without gaps, minimum clearance "
+        f"clean: {f'{part}, ' if part else ''}{edges} edges checked without gaps, minimum "
+        "clearance "
         f"{check.min_clearance:.6g}, {check.queries} clearance queries"
     )
     return 0

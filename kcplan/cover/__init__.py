@@ -7,6 +7,7 @@ file and parameters. Depends on :mod:`kcplan.geometry` only (and trimesh for rea
 """
 
 from kcplan.cover.bodies import body_matrix, inside_union, union_volume
+from kcplan.cover.cache import cache_folder, cached_cover
 from kcplan.cover.fit import SHAPES, Cover, check_cover, fit_cover
 from kcplan.cover.solid import Solid, SolidError, read_solid
 
@@ -16,6 +17,8 @@ __all__ = [
     "Solid",
     "SolidError",
     "body_matrix",
+    "cache_folder",
+    "cached_cover",
     "check_cover",
     "fit_cover",
     "inside_union",

@@ -9,9 +9,10 @@ body from the robot's origin, :attr:`kcplan.geometry.robot.Robot.reach`). Steppi
 using only FCL clearances (the minimum over bodies).
 
 The same walk checks a robot's own part (:class:`kcplan.world.part.PartWorld`, ``kcplan
-verify --mesh``): any world with ``dimension``, ``reach`` and ``safe_clearance(pose)``
-will do, and one with ``encloses_obstacle(pose)`` is also asked whether an obstacle lies
-wholly inside the robot at the first pose (a surface cannot see it there).
+verify --mesh``): any world with ``dimension``, ``safe_clearance(pose)`` and ``reach``
+(or ``robot.reach``) will do, and one with ``encloses_obstacle(pose)`` is also asked
+whether an obstacle lies wholly inside the robot at the first pose (a surface cannot see
+it there).
 """
 
 from __future__ import annotations
@@ -67,7 +68,8 @@ def verify_path(
         Safety limit; exceeding it is reported as a collision (not proven free).
     """
     P = np.asarray(states, dtype=float)
-    n, radius = world.dimension, world.reach
+    n = world.dimension
+    radius = world.reach if hasattr(world, "reach") else world.robot.reach
     queries, lowest = 0, np.inf
     if len(P) == 1:
         P = np.vstack([P, P])

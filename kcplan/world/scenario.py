@@ -18,7 +18,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
@@ -30,6 +30,9 @@ from kcplan.geometry.pose import quaternion_matrix, wrap_angle
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.world.mesh import convex_hull, read_mesh
+
+if TYPE_CHECKING:
+    from kcplan.cover.solid import Solid
 
 __all__ = [
     "DEFAULT_INFLATION",
@@ -137,7 +140,7 @@ class Scenario:
     description: str = ""
     source: str = "<string>"
     directory: Path = field(default_factory=Path.cwd)
-    part: Any = None
+    part: Solid | None = None
     """The robot's own part (:class:`kcplan.cover.Solid`) when the robot is the cover of
     a mesh (``robot: {mesh: ...}``), else None; ``kcplan verify --mesh`` checks it."""
 
