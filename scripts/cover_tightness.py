@@ -102,13 +102,21 @@ def markdown(rows: list[dict], timing: list[dict], samples: int) -> str:
         "| mesh | triangles | K | ellipsoids | spheres | excess ratio | fit (s) |",
         "|---|---:|---:|---:|---:|---:|---:|",
     ]
+    stopped = False
     for r in rows:
+        cells = []
+        for shape in ("ellipsoid", "sphere"):
+            cell = f"{r[f'{shape}_ratio']:.3f} +- {r[f'{shape}_ci']:.3f}"
+            if r[f"{shape}_bodies"] < r["bodies"]:
+                cell += f" ({r[f'{shape}_bodies']} bodies)"
+                stopped = True
+            cells.append(cell)
         out.append(
-            f"| {r['mesh']} | {r['triangles']} | {r['bodies']} | "
-            f"{r['ellipsoid_ratio']:.3f} +- {r['ellipsoid_ci']:.3f} | "
-            f"{r['sphere_ratio']:.3f} +- {r['sphere_ci']:.3f} | {r['excess_ratio']:.2f} | "
-            f"{r['ellipsoid_seconds']:.1f} |"
+            f"| {r['mesh']} | {r['triangles']} | {r['bodies']} | {cells[0]} | {cells[1]} | "
+            f"{r['excess_ratio']:.2f} | {r['ellipsoid_seconds']:.1f} |"
         )
+    if stopped:
+        out += ["", "(N bodies): the fit stopped there, no cut made the union smaller."]
     if timing:
         out += [
             "",

@@ -151,16 +151,17 @@ def _directions(M: NDArray) -> list[NDArray]:
 
 
 class _Scorer:
-    """Union volume on a fixed quasi-random sample of the whole part's ellipsoid, grown by
-    a tenth (children stick out of it little; what does is not scored)."""
+    """Union volume on a fixed quasi-random sample of the part's bounding box, padded by a
+    tenth (what a body has outside the box is added from its exact volume)."""
 
-    def __init__(self, center: NDArray, M: NDArray):
-        n = len(center)
-        u = 2.0 * qmc.Sobol(n, seed=0).random(SCORE_SAMPLES) - 1.0
-        u = 1.1 * u[np.einsum("mi,mi->m", u, u) <= 1.0]
-        L = np.linalg.cholesky(np.linalg.inv(M))
-        self.points = center + u @ L.T
-        self.cell = 1.1**n * ellipsoid_volume(M) / len(u)
+    def __init__(self, solid: Solid):
+        V = solid.boundary.reshape(-1, solid.dimension)
+        low, high = V.min(axis=0), V.max(axis=0)
+        pad = 0.1 * (high - low)
+        low, high = low - pad, high + pad
+        u = qmc.Sobol(solid.dimension, seed=0).random(SCORE_SAMPLES)
+        self.points = low + u * (high - low)
+        self.cell = float(np.prod(high - low)) / SCORE_SAMPLES
 
     def inside(self, center: NDArray, M: NDArray) -> NDArray[np.bool_]:
         return mahalanobis_sq(self.points, center, M) <= 1.0
@@ -212,7 +213,7 @@ def fit_cover(
     c, M = _enclosing(whole.points(solid.boundary), shape, FINAL_TOL)
     root: dict = {}
     leaves = [_Leaf(root, whole, c, M)]
-    scorer = _Scorer(c, M)
+    scorer = _Scorer(solid)
     inside = [scorer.inside(c, M)]
     note = ""
     while len(leaves) < target:
