@@ -552,3 +552,21 @@ def test_the_cache_folder_follows_the_environment(monkeypatch, tmp_path):
     assert cache_folder() == tmp_path / "kcplan" / "covers"
     monkeypatch.setenv("KCPLAN_CACHE_DIR", os.fspath(tmp_path / "x"))
     assert cache_folder() == tmp_path / "x"
+
+
+def test_a_2d_outline_robot_is_planned_and_its_polygon_verified(tmp_path, capsys):
+    """An L-shaped outline (CSV) as the robot of the l_turn map: planned with its cover of
+    3 ellipses, its own polygon verified (prisms of its convex pieces in FCL)."""
+    (tmp_path / "l.csv").write_text("x,y\n-2,-0.8\n2.5,-0.8\n2.5,0.8\n-0.8,0.8\n-0.8,2\n-2,2\n")
+    data = yaml.safe_load((ROOT / "scenarios" / "2d" / "l_turn.yaml").read_text())
+    data["robot"] = {"mesh": "l.csv", "bodies": 3, "inflation": 0.08}
+    scenario, out = tmp_path / "l2d.yaml", tmp_path / "p.json"
+    scenario.write_text(yaml.safe_dump(data))
+    assert main(["plan", str(scenario), "--seed", "1", "--time", "10", "-o", str(out)]) == 0
+    assert main(["verify", str(scenario), str(out), "--mesh"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].startswith("clean: the part l.csv (6-gon)")
+    doc = json.loads(out.read_text())
+    doc["states"] = [doc["states"][0], [50.0, 50.0, 0.0]]  # straight into the inner corner
+    out.write_text(json.dumps(doc))
+    assert main(["verify", str(scenario), str(out), "--mesh"]) == 1
+    assert "COLLISION of the part l.csv (6-gon) on edge 0" in capsys.readouterr().out
