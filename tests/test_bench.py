@@ -22,7 +22,13 @@ from kcplan.bench.campaign import (
     run_campaign,
     run_isolated,
 )
-from kcplan.bench.summary import SUMMARY_COLUMNS, ca_twin_of, summarize, twin_of
+from kcplan.bench.summary import (
+    SUMMARY_COLUMNS,
+    ca_twin_of,
+    summarize,
+    summary_markdown,
+    twin_of,
+)
 from kcplan.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -460,3 +466,19 @@ def test_distribution_plot_of_a_scenario_nobody_solved(tmp_path):
     out = tmp_path / "s.png"
     plot_distributions(records, "s", out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_mesh_robots_paths_are_checked_on_its_part_too(tmp_path):
+    """hand_through_slot's robot is the cover of the hand's mesh: the worker verifies each
+    path on the cover and on the mesh, and the summary says so."""
+    hand = str(ROOT / "scenarios/3d/hand_through_slot.yaml")
+    spec = campaign_specs([(hand, "hand_through_slot")], ["kc-rrtconnect"], 1, 1, 10.0)[0]
+    record = run_isolated(spec, 120.0, WORKER_COMMAND)
+    assert record["status"] == "ok" and record["solved"], record.get("reason")
+    assert record["collides"] is False and record["part_collides"] is False
+    (row,) = summarize([{**spec.__dict__, **record, "scenario_name": "hand_through_slot"}])
+    assert (row["checked_parts"], row["colliding_parts"]) == (1, 0)
+    assert "| hand_through_slot | kc-rrtconnect | 1 | 0 |" in summary_markdown([row])
+    plain = run_isolated(campaign_specs([(OPEN, "open_field")], ["rrtconnect"], 1, 1, 2.0)[0],
+                         60.0, WORKER_COMMAND)  # fmt: skip
+    assert plain["part_collides"] is None

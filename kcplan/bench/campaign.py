@@ -363,6 +363,8 @@ def describe_run(record: dict) -> str:
     if not record["solved"]:
         return f"{head}: unsolved in {record['time']:.2f} s, {queries} FCL queries"
     path = "PATH COLLIDES" if record["collides"] else "path clean"
+    if record.get("part_collides") is not None:  # a mesh robot: its part checked too
+        path += ", PART COLLIDES" if record["part_collides"] else ", part clean"
     found = f"solved in {record['time']:.3f} s"
     if record.get("first_solution_time") is not None:
         found = f"first solution at {record['first_solution_time']:.3f} s"

@@ -57,6 +57,8 @@ COST_FRACTIONS = {"median_cost_10pct": 0.1, "median_cost_50pct": 0.5, "median_co
 COST_COLUMNS = tuple(COST_FRACTIONS)
 
 EXTRA_COLUMNS = (
+    "checked_parts",
+    "colliding_parts",
     "failed_runs",
     "median_collision_queries",
     "median_distance_queries",
@@ -149,6 +151,8 @@ def summarize(records: Sequence[dict]) -> list[dict]:
                 "median_fcl_queries": counter("fcl_queries"),
                 "median_length": _median([r["length"] for r in solved]),
                 "colliding_paths": sum(bool(r["collides"]) for r in solved),
+                "checked_parts": sum(r.get("part_collides") is not None for r in solved),
+                "colliding_parts": sum(bool(r.get("part_collides")) for r in solved),
                 "failed_runs": len(runs) - len(finished),
                 "median_collision_queries": counter("collision_queries"),
                 "median_distance_queries": counter("distance_queries"),
@@ -256,6 +260,20 @@ def summary_markdown(rows: Sequence[dict], title: str = "Benchmark summary") -> 
             f"| {_fmt(r['ca_time_ratio'], '.2f')} | {_fmt(r['ca_query_ratio'], '.2f')} "
             f"| {_fmt(r['share_region'], '.2f')} | {_fmt(r['share_polytope'], '.2f')} |"
         )
+    parts = [r for r in rows if r["checked_parts"]]
+    if parts:
+        out += [
+            "",
+            "Mesh robots (`robot.mesh`): every solved path was also checked without gaps "
+            "against the part's own mesh (`kcplan verify --mesh`).",
+            "",
+            "| scenario | planner | paths checked | part colliding |",
+            "|---|---|---|---|",
+        ]
+        out += [
+            f"| {r['scenario']} | {r['planner']} | {r['checked_parts']} | {r['colliding_parts']} |"
+            for r in parts
+        ]
     anytime = [r for r in rows if not math.isnan(r["median_cost_final"])]
     if anytime:
         out += [

@@ -30,8 +30,9 @@ def execute(spec: dict) -> dict:
     ``backend`` (``"kernel"`` or ``"python"``: who checked, see
     :class:`kcplan.planning.problem.PlannerSpec`),
     ``collides`` / ``min_clearance`` / ``verify_queries`` (gap-free verification; None
-    when unsolved), ``memory_mb`` (peak resident set of the worker) and ``wall`` (seconds
-    of the whole run).
+    when unsolved), ``part_collides`` (the same check of the part's own mesh when the
+    robot is the cover of one, ``robot.mesh``; None otherwise), ``memory_mb`` (peak
+    resident set of the worker) and ``wall`` (seconds of the whole run).
     """
     t0 = time.perf_counter()
     from kcplan.planning.problem import plan
@@ -50,6 +51,11 @@ def execute(spec: dict) -> dict:
         progress=spec.get("progress"),
     )
     check = verify_path(world, result.states) if result.solved else None
+    part = None
+    if check is not None and scenario.part is not None:
+        from kcplan.world.part import PartWorld
+
+        part = verify_path(PartWorld(world, scenario.part), result.states)
     return {
         "status": "ok",
         "reason": "",
@@ -66,6 +72,7 @@ def execute(spec: dict) -> dict:
         "collides": None if check is None else check.collides,
         "min_clearance": None if check is None else check.min_clearance,
         "verify_queries": None if check is None else check.queries,
+        "part_collides": None if part is None else part.collides,
         "memory_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "wall": time.perf_counter() - t0,
     }
