@@ -16,6 +16,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from kcplan.files import write_text_atomic
+from kcplan.geometry.pose import pose_frame
 from kcplan.maps.superquadric import unit_normals
 from kcplan.viz import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
@@ -59,10 +60,34 @@ def _mesh(V: np.ndarray, F: np.ndarray, color: str, opacity: float, name: str) -
     )  # fmt: skip
 
 
+def _part_mesh(part) -> tuple[np.ndarray, np.ndarray]:
+    """A robot's part (:class:`kcplan.cover.Solid`) as one triangle mesh in its frame
+    (2D: its convex pieces fanned at z = 0)."""
+    if part.dimension == 3:
+        return part.vertices, part.faces
+    from kcplan.geometry.polygon import convex_pieces
+
+    meshes = [_flat(piece) for piece in convex_pieces(part.vertices)]
+    starts = np.cumsum([0] + [len(V) for V, _ in meshes[:-1]])
+    return np.vstack([V for V, _ in meshes]), np.vstack(
+        [F + k for (_, F), k in zip(meshes, starts, strict=True)]
+    )
+
+
 def _robot(scenario: Scenario, pose, color: str, name: str) -> list[go.Mesh3d]:
+    """The robot's bodies at ``pose``; a mesh robot's part solid inside its see-through
+    cover."""
     n = scenario.dimension
-    return [
-        _mesh(*_ellipsoid(t, R, a, n), color, 0.9, name)
+    traces = []
+    if scenario.part is not None:
+        V, F = _part_mesh(scenario.part)
+        R, t = pose_frame(np.asarray(pose, dtype=float), n)
+        R3, t3 = np.eye(3), np.zeros(3)
+        R3[:n, :n], t3[:n] = R, t
+        traces.append(_mesh(V @ R3.T + t3, F, color, 1.0, f"{name} (part)"))
+    opacity = 0.25 if traces else 0.9
+    return traces + [
+        _mesh(*_ellipsoid(t, R, a, n), color, opacity, name)
         for R, t, a in body_shapes(scenario.robot, pose)
     ]
 
@@ -109,7 +134,8 @@ def scene_figure(scenario: Scenario, states=None, frames: int = 60) -> go.Figure
     figure = go.Figure(data=traces, frames=figure_frames)
     low, high = scenario.bounds
     figure.update_layout(
-        title=f"{scenario.name}: {scenario.robot.describe()}",
+        title=f"{scenario.name}: {scenario.robot.describe()}"
+        + (f" covering {scenario.part.describe()}" if scenario.part is not None else ""),
         scene={"aspectmode": "data", "xaxis_title": "x", "yaxis_title": "y", "zaxis_title": "z"},
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
         showlegend=False,

@@ -34,6 +34,7 @@ __all__ = [
     "ellipsoid_surface",
     "scenario_axes",
     "plot_cover",
+    "part_at",
 ]
 
 
@@ -136,6 +137,15 @@ def body_shapes(robot: Robot, pose, inflation: float = 0.0):
         yield R, t, (1.0 + inflation) * body.semi_axes
 
 
+def part_at(part, pose) -> np.ndarray:
+    """A mesh robot's part (:class:`kcplan.cover.Solid`) at a robot pose, in the world:
+    its polygon ``(k, 2)`` (2D) or its triangles ``(m, 3, 3)`` (3D)."""
+    n = part.dimension
+    R, t = pose_frame(np.asarray(pose, dtype=float), n)
+    placed = part.vertices @ R.T + t
+    return placed if n == 2 else placed[part.faces]
+
+
 def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None) -> None:
     """Draw a scenario's obstacles, bounds, start and goal robots on ``ax``.
 
@@ -147,8 +157,11 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
         Extra robot poses to draw (e.g. along a path), in the flat pose layout.
     guards : float, optional
         Also outline the guard ``(1 + guards) a`` of every body at start and goal.
+
+    A mesh robot (``robot.mesh``) is drawn as its part inside its see-through cover.
     """
-    n, robot = scenario.dimension, scenario.robot
+    n, robot, part = scenario.dimension, scenario.robot, scenario.part
+    cover_alpha = 0.5 if part is None else 0.2
     low, high = scenario.bounds
     if n == 2:
         from matplotlib.patches import Polygon, Rectangle
@@ -175,17 +188,21 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
         for pose in poses:
             for R, t, a in body_shapes(robot, pose):
                 ax.plot(*ellipse_outline(t, R, a).T, color="tab:blue", lw=0.6, alpha=0.6)
+            if part is not None:
+                ax.add_patch(Polygon(part_at(part, pose), closed=True, fc="tab:blue", alpha=0.3))
         for pose, color, label in (
             (scenario.start, "tab:green", "start"),
             (scenario.goal, "tab:red", "goal"),
         ):
+            if part is not None:
+                ax.add_patch(Polygon(part_at(part, pose), closed=True, fc=color, ec="k", lw=0.5))
             for k, (R, t, a) in enumerate(body_shapes(robot, pose)):
                 ax.add_patch(
                     Polygon(
                         ellipse_outline(t, R, a),
                         closed=True,
                         fc=color,
-                        alpha=0.5,
+                        alpha=cover_alpha,
                         ec=color,
                         label=label if k == 0 else None,
                     )
@@ -226,8 +243,16 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
             surface = ellipsoid_surface(t, R, a, 8)
             ax.plot_wireframe(*surface, color="tab:blue", lw=0.3, alpha=0.5)
     for pose, color in ((scenario.start, "tab:green"), (scenario.goal, "tab:red")):
+        if part is not None:
+            ax.add_collection3d(Poly3DCollection(part_at(part, pose), facecolors=color,
+                                                 edgecolors="k", linewidths=0.1))  # fmt: skip
         for R, t, a in body_shapes(robot, pose):
-            ax.plot_surface(*ellipsoid_surface(t, R, a), color=color, alpha=0.8, linewidth=0)
+            ax.plot_surface(
+                *ellipsoid_surface(t, R, a),
+                color=color,
+                alpha=0.8 if part is None else cover_alpha,
+                linewidth=0,
+            )
     corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
     for i in range(8):
         for j in range(i + 1, 8):

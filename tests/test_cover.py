@@ -505,9 +505,12 @@ def test_the_mesh_scenario_is_planned_and_its_part_verified(tmp_path, capsys, mo
     passes the independent gap-free check with python-fcl."""
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path / "cache"))
     scenario = str(ROOT / "scenarios" / "3d" / "hand_through_slot.yaml")
-    out = tmp_path / "path.json"
-    assert main(["plan", scenario, "--seed", "2", "--time", "10", "-o", str(out)]) == 0
+    out, html = tmp_path / "path.json", tmp_path / "hand.html"
+    argv = ["plan", scenario, "--seed", "2", "--time", "10", "-o", str(out), "--html", str(html)]
+    assert main(argv) == 0
     assert "solved by kc-rrtconnect" in capsys.readouterr().out
+    view = html.read_text()  # the hand itself is drawn, inside its see-through cover
+    assert '"name":"start (part)"' in view and "covering panda_hand.stl" in view
     assert main(["verify", scenario, str(out), "--mesh"]) == 0
     text = capsys.readouterr().out
     assert text.startswith("clean: the part panda_hand.stl (200 triangles)")
