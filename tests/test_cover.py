@@ -378,7 +378,7 @@ def test_open_and_flat_meshes_are_refused_and_hull_is_the_fallback(tmp_path, cap
     assert "--bodies: expected 1 to 32, got 33" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("fmt", ["stl", "obj", "ply", "off", "glb"])
+@pytest.mark.parametrize("fmt", ["stl", "obj", "ply", "off", "glb", "gltf"])
 def test_every_mesh_format_reads_the_same_part(tmp_path, fmt):
     box = trimesh.creation.box((1, 2, 3))
     box.export(tmp_path / f"box.{fmt}")

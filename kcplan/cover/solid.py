@@ -55,7 +55,8 @@ class Solid:
     source : str
         The file it came from.
     digest : str
-        SHA-256 of the file's bytes (the cover cache's key).
+        SHA-256 of the file's bytes and, for meshes, of the triangles read (the cover
+        cache's key; a glTF's buffers may live in other files).
     hull : bool
         True when the part is the convex hull of the file's mesh (``--hull``).
     """
@@ -125,14 +126,15 @@ def read_solid(path: str | os.PathLike, scale: float = 1.0, hull: bool = False) 
         if hull:
             raise SolidError(f"{source}: --hull: expected a mesh, got a 2D outline")
         return _outline(source, data, suffix, scale, digest)
-    return _mesh(source, data, suffix, scale, digest, hull)
+    return _mesh(source, suffix, scale, digest, hull)
 
 
-def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull: bool) -> Solid:
+def _mesh(source: str, suffix: str, scale: float, digest: str, hull: bool) -> Solid:
     import trimesh
 
     try:
-        loaded = trimesh.load(io.BytesIO(data), file_type=suffix[1:], force="mesh", process=False)
+        # from the path, not the bytes: a .gltf's buffers may lie beside it
+        loaded = trimesh.load(source, force="mesh", process=False)
     except Exception as err:  # trimesh raises many kinds on malformed files
         reason = str(err).splitlines()[0][:120] if str(err) else type(err).__name__
         raise SolidError(f"{source}: expected a readable {suffix} mesh, got: {reason}") from None
@@ -172,6 +174,8 @@ def _mesh(source: str, data: bytes, suffix: str, scale: float, digest: str, hull
     if not volume > 1e-12 * mesh.extents.max() ** 3:
         raise SolidError(f"{source}: expected a mesh with volume, got volume {volume:.3g}")
     triangles = mesh.vertices[mesh.faces]
+    # the geometry too: a .gltf's buffers live in other files than the one hashed
+    digest = hashlib.sha256(digest.encode() + triangles.tobytes()).hexdigest()
     return Solid(triangles, volume, mesh.vertices.copy(), mesh.faces.copy(), source, digest, hull)
 
 
