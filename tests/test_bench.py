@@ -482,3 +482,22 @@ def test_a_mesh_robots_paths_are_checked_on_its_part_too(tmp_path):
     plain = run_isolated(campaign_specs([(OPEN, "open_field")], ["rrtconnect"], 1, 1, 2.0)[0],
                          60.0, WORKER_COMMAND)  # fmt: skip
     assert plain["part_collides"] is None
+
+
+def test_bench_outputs_follow_the_umask(tmp_path):
+    """Logs, results.db, summaries and plots are readable by the group and others under
+    umask 022, as any file written with open() would be (mkstemp alone gave 0600)."""
+    import os
+    import stat
+
+    out = tmp_path / "b"
+    old = os.umask(0o022)
+    try:
+        argv = ["bench", OPEN, "--planners", "rrtconnect", "--runs", "1", "--time", "1"]
+        assert main([*argv, "-o", str(out)]) == 0
+    finally:
+        os.umask(old)
+    files = [p for p in out.rglob("*") if p.is_file()]
+    assert {p.name for p in files} >= {"results.db", "summary.csv", "summary.md"}
+    modes = {p.relative_to(out).as_posix(): stat.S_IMODE(p.stat().st_mode) for p in files}
+    assert set(modes.values()) == {0o644}, modes
