@@ -573,3 +573,44 @@ def test_a_2d_outline_robot_is_planned_and_its_polygon_verified(tmp_path, capsys
     out.write_text(json.dumps(doc))
     assert main(["verify", str(scenario), str(out), "--mesh"]) == 1
     assert "COLLISION of the part l.csv (6-gon) on edge 0" in capsys.readouterr().out
+
+
+_TEXT = st.one_of(
+    st.binary(max_size=300),
+    st.lists(st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=3), max_size=12).map(
+        lambda rows: yaml.safe_dump(rows).encode()
+    ),
+    st.lists(st.tuples(st.floats(-10, 10), st.floats(-10, 10)), max_size=12).map(
+        lambda rows: ("x,y\n" + "\n".join(f"{x},{y}" for x, y in rows)).encode()
+    ),
+    st.sampled_from(
+        [
+            b"solid x\nendsolid x\n",
+            b"ply\nformat ascii 1.0\nend_header\n",
+            b"OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ]
+    ),  # fmt: skip
+)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_TEXT, st.sampled_from([".stl", ".obj", ".ply", ".off", ".yaml", ".csv"]))
+def test_robot_fit_of_any_file_is_a_cover_or_one_line(tmp_path_factory, data, suffix):
+    """Fuzzed files: exit 0 with a robot block, or exit 2 with one line and no output."""
+    import contextlib
+    import io
+
+    folder = tmp_path_factory.mktemp("fuzz")
+    path, out = folder / f"part{suffix}", folder / "robot.yaml"
+    path.write_bytes(data)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = main(["robot", "fit", str(path), "--bodies", "2", "-o", str(out)])
+    assert code in (0, 2)
+    if code == 2:
+        assert err.getvalue().count("\n") == 1 and str(path) in err.getvalue()
+        assert not out.exists()
+    else:
+        bodies = yaml.safe_load(out.read_text())["robot"]["bodies"]
+        assert 1 <= len(bodies) <= 2
