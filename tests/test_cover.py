@@ -614,3 +614,36 @@ def test_robot_fit_of_any_file_is_a_cover_or_one_line(tmp_path_factory, data, su
     else:
         bodies = yaml.safe_load(out.read_text())["robot"]["bodies"]
         assert 1 <= len(bodies) <= 2
+
+
+def _two_boxes() -> trimesh.Trimesh:
+    far = trimesh.creation.box((1, 2, 1))
+    far.apply_translation([3, 0, 0])
+    return trimesh.util.concatenate([trimesh.creation.box((1, 1, 1)), far])
+
+
+def _inverted_capsule() -> trimesh.Trimesh:
+    capsule = trimesh.creation.capsule(2, 0.5)
+    capsule.invert()  # inward normals: a negative volume
+    return capsule
+
+
+def _flipped_triangles() -> trimesh.Trimesh:
+    ball = trimesh.creation.icosphere(2)
+    faces = ball.faces.copy()
+    faces[::3] = faces[::3, ::-1]  # every third triangle wound the other way
+    return trimesh.Trimesh(ball.vertices, faces, process=False)
+
+
+@pytest.mark.parametrize("make", [_two_boxes, _inverted_capsule, _flipped_triangles])
+def test_disjoint_inverted_and_badly_wound_meshes_are_covered(tmp_path, make):
+    """CAD exports with several shells, inward normals or flipped triangles: the part is
+    the same solid (only the winding is repaired), and its cover holds it."""
+    mesh = make()
+    mesh.export(tmp_path / "part.stl")
+    solid = read_solid(tmp_path / "part.stl")
+    exact = trimesh.load(tmp_path / "part.stl", force="mesh")
+    trimesh.repair.fix_normals(exact)
+    assert math.isclose(solid.volume, abs(exact.volume), rel_tol=1e-9)
+    cover = fit_cover(solid, bodies=3)
+    _assert_covered(solid, cover, exact, 20_000)
