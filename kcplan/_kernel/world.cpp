@@ -303,6 +303,9 @@ void World::count_body(std::size_t k) {
 
 bool World::collides(coal::CollisionObject& object) {
   coal::CollisionCallBackDefault callback;
+  // a yes/no answer: GJK may stop as soon as it proves the pair apart (distance > 0)
+  // instead of converging on the distance, which coal's default (no bound) does
+  callback.data.request.distance_upper_bound = 0.0;
   callback.init();
   manager_->collide(&object, &callback);
   return callback.data.result.isCollision();
