@@ -1,8 +1,10 @@
-"""Cost of one FCL collision query and one clearance query per scenario.
+"""Cost of one collision query and one clearance query per scenario, python-fcl and kernel.
 
-Times ``CollisionWorld.in_collision`` and ``CollisionWorld.clearance`` at random poses
-inside each scenario's bounds (fixed seed), in repeated blocks, and prints the median
-time per query over blocks, in microseconds::
+Times ``CollisionWorld.in_collision`` and ``CollisionWorld.clearance`` (python-fcl), and
+the compiled kernel's collision query as a stock state check makes it
+(``World.in_collision_se2`` / ``_se3``, coal), at random poses inside each scenario's
+bounds (fixed seed), in repeated blocks, and prints the median time per query over
+blocks, in microseconds::
 
     python scripts/bench_queries.py scenarios/*/*.yaml [--poses 2000] [--blocks 7]
 """
@@ -45,7 +47,7 @@ def main() -> None:
     rng = np.random.default_rng(0)
     print(
         f"{'scenario':<18} {'fcl objects':>11} {'collision us':>13} "
-        f"{'clearance us':>13} {'ratio':>6}"
+        f"{'clearance us':>13} {'ratio':>6} {'kernel collision us':>20}"
     )
     for path in args.scenarios:
         scenario = load_scenario(path)
@@ -53,7 +55,14 @@ def main() -> None:
         poses = random_poses(scenario, args.poses, rng)
         c = per_query_us(world.in_collision, poses, args.blocks)
         d = per_query_us(world.clearance, poses, args.blocks)
-        print(f"{scenario.name:<18} {world.n_objects:>11} {c:>13.1f} {d:>13.1f} {d / c:>6.2f}")
+        kernel = world.kernel
+        fast = kernel.in_collision_se2 if scenario.dimension == 2 else kernel.in_collision_se3
+        rows = [p.tolist() for p in poses]  # plain floats, as the state checker passes
+        k = per_query_us(lambda p, fast=fast: fast(*p), rows, args.blocks)
+        print(
+            f"{scenario.name:<18} {world.n_objects:>11} {c:>13.1f} {d:>13.1f} {d / c:>6.2f} "
+            f"{k:>20.2f}"
+        )
 
 
 if __name__ == "__main__":

@@ -82,7 +82,10 @@ CASES = [
     Case(
         "bench_queries.py",
         (CORRIDOR, "--poses", "50", "--blocks", "1"),
-        (r"collision us", rf"narrow_corridor\s+2\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}"),
+        (
+            r"kernel collision us",
+            rf"narrow_corridor\s+2\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}$",
+        ),
     ),
     *(
         Case(
