@@ -360,10 +360,12 @@ def plot_cover(cover, path: str | os.PathLike, tightness: str = "") -> None:
         return
     fig = plt.figure(figsize=(12, 6))
     corners = solid.vertices[solid.faces]
+    from kcplan.cover.bodies import body_bounds
+
     low, high = solid.vertices.min(axis=0), solid.vertices.max(axis=0)
-    for R, t, a in shapes:  # the bodies stick out of the part
-        half = np.sqrt(((R * a) ** 2).sum(axis=1))
-        low, high = np.minimum(low, t - half), np.maximum(high, t + half)
+    for body in robot.bodies:  # the bodies stick out of the part
+        box_low, box_high = body_bounds(body)
+        low, high = np.minimum(low, box_low), np.maximum(high, box_high)
     for i, (elev, azim) in enumerate(((25, -60), (85, -90))):
         ax = fig.add_subplot(1, 2, i + 1, projection="3d")
         ax.add_collection3d(

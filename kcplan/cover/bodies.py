@@ -20,6 +20,7 @@ from kcplan.geometry.robot import Body
 from kcplan.geometry.rotations import exp_rotation
 
 __all__ = [
+    "body_bounds",
     "body_from_ellipsoid",
     "body_holds",
     "body_matrix",
@@ -58,6 +59,13 @@ def body_rotation(body: Body) -> NDArray[np.float64]:
     )
 
 
+def body_bounds(body: Body) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The body's axis-aligned bounding box in the robot frame, ``(low, high)``: the half
+    side along axis ``i`` is ``|row i of R diag(a)|``."""
+    half = np.linalg.norm(body_rotation(body) * body.semi_axes, axis=1)
+    return body.position - half, body.position + half
+
+
 def body_holds(body: Body, points: ArrayLike) -> float:
     """The largest ``|diag(1/a) R^T (x - p)|^2`` of the points, in the body's own frame as
     stored (semi-axes, position, yaw or quaternion): at most 1 when the body holds them
@@ -83,12 +91,8 @@ def union_volume(
     Uniform samples in the union's bounding box; the standard error is
     ``box * sqrt(f (1 - f) / samples)`` for the fraction ``f`` inside.
     """
-    low, high = [], []
-    for body in bodies:
-        half = np.sqrt(np.diag(np.linalg.inv(body_matrix(body))))  # extent along each axis
-        low.append(body.position - half)
-        high.append(body.position + half)
-    low, high = np.min(low, axis=0), np.max(high, axis=0)
+    boxes = np.array([body_bounds(body) for body in bodies])  # (k, 2, n)
+    low, high = boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)
     box = float(np.prod(high - low))
     rng = np.random.default_rng(seed)
     f = float(inside_union(rng.uniform(low, high, (samples, len(low))), bodies).mean())

@@ -111,6 +111,7 @@ class Cover:
 class _Leaf:
     node: dict
     piece: Piece
+    points: NDArray  # the piece's hull points (partition.Piece.points), which M holds
     center: NDArray
     M: NDArray
     candidates: list | None = None  # from _candidates(), once computed
@@ -210,9 +211,10 @@ def fit_cover(
     start = time.perf_counter()
     target = bodies if bodies is not None else MAX_BODIES
     whole = Piece.whole(solid.boundary)
-    c, M = _enclosing(whole.points(solid.boundary), shape, FINAL_TOL)
+    points = whole.points(solid.boundary)
+    c, M = _enclosing(points, shape, FINAL_TOL)
     root: dict = {}
-    leaves = [_Leaf(root, whole, c, M)]
+    leaves = [_Leaf(root, whole, points, c, M)]
     scorer = _Scorer(solid)
     inside = [scorer.inside(c, M)]
     note = ""
@@ -240,9 +242,10 @@ def fit_cover(
         leaf.node["plane"] = [*normal.tolist(), float(offset)]
         for side, sign in (("below", 1.0), ("above", -1.0)):
             piece = leaf.piece.cut(sign * normal, sign * offset)
-            c, M = _enclosing(piece.points(solid.boundary), shape, FINAL_TOL)
+            points = piece.points(solid.boundary)
+            c, M = _enclosing(points, shape, FINAL_TOL)
             leaf.node[side] = {}
-            leaves.append(_Leaf(leaf.node[side], piece, c, M))
+            leaves.append(_Leaf(leaf.node[side], piece, points, c, M))
             inside.append(scorer.inside(c, M))
         for other in leaves:  # the union changed: every score is stale
             other.split = None
@@ -255,8 +258,8 @@ def fit_cover(
     out = []
     for k, leaf in enumerate(leaves):
         leaf.node["body"] = k
-        out.append(_sound_body(leaf, solid, shape))
-    worst = check_cover(solid, root, out)
+        out.append(_sound_body(leaf, shape))
+    worst = max(body_holds(body, leaf.points) for body, leaf in zip(out, leaves, strict=True))
     return Cover(solid, tuple(out), root, shape, time.perf_counter() - start, note, worst)
 
 
@@ -296,13 +299,12 @@ def _best_cut(leaf: _Leaf, scorer: _Scorer, others: NDArray) -> tuple:
     return best
 
 
-def _sound_body(leaf: _Leaf, solid: Solid, shape: str) -> Body:
+def _sound_body(leaf: _Leaf, shape: str) -> Body:
     """The leaf's ellipsoid as a body, grown until it holds every hull point of its piece
     as computed from the stored semi-axes and pose."""
-    points = leaf.piece.points(solid.boundary)
     body = body_from_ellipsoid(leaf.center, leaf.M, sphere=shape == "sphere")
     for _ in range(8):
-        worst = body_holds(body, points)
+        worst = body_holds(body, leaf.points)
         if worst < 1.0:
             return body
         body = Body(body.semi_axes * np.sqrt(worst) * (1.0 + 1e-9), body.pose)
