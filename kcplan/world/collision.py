@@ -304,10 +304,19 @@ class CollisionWorld:
         out = np.empty(len(self._bodies))
         for k, body in enumerate(self._bodies):
             self._count_body(k)
-            data = fcl.DistanceData()
-            self._manager.distance(body, data, fcl.defaultDistanceCallback)
-            out[k] = max(float(data.result.min_distance), 0.0)
+            out[k] = self._distance(body)
         return out
+
+    def _distance(self, obj: fcl.CollisionObject) -> float:
+        """One broad- and narrow-phase distance query of ``obj`` against the obstacles
+        (0 on contact or overlap)."""
+        data = fcl.DistanceData()
+        self._manager.distance(obj, data, fcl.defaultDistanceCallback)
+        return max(float(data.result.min_distance), 0.0)
+
+    def _safe(self, d):
+        """FCL's error allowance: ``max(d (1 - CLEARANCE_RTOL) - clearance_atol, 0)``."""
+        return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
 
     def clearance(self, pose: ArrayLike) -> float:
         """Distance from the robot at ``pose`` to the nearest obstacle, the minimum of
@@ -318,8 +327,7 @@ class CollisionWorld:
         """:meth:`body_clearances` reduced by FCL's error allowance, distances that are
         certain: ``max(d (1 - CLEARANCE_RTOL) - clearance_atol, 0)`` with
         ``clearance_atol = CLEARANCE_ATOL * scene size`` (one distance query)."""
-        d = self.body_clearances(pose)
-        return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+        return self._safe(self.body_clearances(pose))
 
     def object_clearance(self, obj: fcl.CollisionObject) -> float:
         """Distance from any FCL object, placed by the caller, to the nearest obstacle,
@@ -329,10 +337,7 @@ class CollisionWorld:
         self._fcl_counters["distance_queries"] += 1
         if not self._objects:
             return math.inf
-        data = fcl.DistanceData()
-        self._manager.distance(obj, data, fcl.defaultDistanceCallback)
-        d = max(float(data.result.min_distance), 0.0)
-        return max(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+        return float(self._safe(self._distance(obj)))
 
     @property
     def half_height(self) -> float:
