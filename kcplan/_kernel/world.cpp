@@ -100,9 +100,69 @@ struct Collect : coal::CollisionCallBackBase {
 /// fixed here because the error allowance was measured with it): at 1e-4 coal's distances
 /// exceeded python-fcl's by up to 7.6e-3 relative on window_wall, above the allowance;
 /// Nesterov acceleration was 6x slower against large boxes.
-void tune(coal::QueryRequest& request) { request.gjk_tolerance = 1e-6; }
+///
+/// Every query starts GJK from the pair's warm start (CachedGuess), set per pair.
+coal::DistanceRequest distance_request(bool nearest_points) {
+  // an overlap only needs to be known (clearance 0), not measured: no EPA
+  coal::DistanceRequest request(nearest_points, /*enable_signed_distance=*/false);
+  request.gjk_tolerance = 1e-6;
+  request.gjk_initial_guess = coal::GJKInitialGuess::CachedGuess;
+  return request;
+}
+
+/// A yes/no collision request: no contact (so no EPA on an overlap), and GJK may stop as
+/// soon as it proves a pair apart (distance > 0) instead of converging on the distance,
+/// which coal's default (no bound) does.
+coal::CollisionRequest collision_request() {
+  coal::CollisionRequest request(coal::NO_REQUEST, 1);
+  request.enable_contact = false;
+  request.distance_upper_bound = 0.0;
+  request.gjk_initial_guess = coal::GJKInitialGuess::CachedGuess;
+  return request;
+}
 
 }  // namespace
+
+/// The broad phase's candidates for one query shape, each tried with its pair's warm
+/// start; stops at the first obstacle that touches the shape.
+struct World::CollideNear : coal::CollisionCallBackBase {
+  World* world = nullptr;
+  coal::CollisionObject* query = nullptr;
+  std::size_t shape = 0;
+  bool hit = false;
+  coal::CollisionRequest request = collision_request();
+  coal::CollisionResult result;
+  bool collide(coal::CollisionObject* o1, coal::CollisionObject* o2) override {
+    coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
+    WarmStart& w = world->warm(shape, *obstacle);
+    request.cached_gjk_guess = w.guess;
+    request.cached_support_func_guess = w.hint;
+    result.clear();
+    coal::collide(query, obstacle, request, result);
+    w.guess = result.cached_gjk_guess;
+    w.hint = result.cached_support_func_guess;
+    hit = result.isCollision();
+    return hit;
+  }
+};
+
+/// The smallest distance of one query shape to the broad phase's candidates, which the
+/// broad phase uses to prune; stops at contact.
+struct World::DistanceNear : coal::DistanceCallBackBase {
+  World* world = nullptr;
+  coal::CollisionObject* query = nullptr;
+  std::size_t shape = 0;
+  double best = std::numeric_limits<double>::infinity();
+  coal::DistanceRequest request = distance_request(false);
+  coal::DistanceResult result;
+  bool distance(coal::CollisionObject* o1, coal::CollisionObject* o2,
+                coal::CoalScalar& dist) override {
+    coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
+    best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
+    dist = best;
+    return best <= 0.0;
+  }
+};
 
 double World::Support::operator()(const double* n) const {
   switch (kind) {
@@ -277,6 +337,7 @@ void World::finalize() {
     manager_->registerObjects(raw);
     manager_->setup();
   }
+  warm_.assign((bodies_.size() + 1) * objects_.size(), WarmStart{});
   finalized_ = true;
 }
 
@@ -301,26 +362,39 @@ void World::count_body(std::size_t k) {
   ++body_query_counts[k];
 }
 
-bool World::collides(coal::CollisionObject& object) {
-  coal::CollisionCallBackDefault callback;
-  // a yes/no answer: GJK may stop as soon as it proves the pair apart (distance > 0)
-  // instead of converging on the distance, which coal's default (no bound) does
-  callback.data.request.distance_upper_bound = 0.0;
-  callback.init();
-  manager_->collide(&object, &callback);
-  return callback.data.result.isCollision();
+World::WarmStart& World::warm(std::size_t shape, const coal::CollisionObject& obstacle) {
+  return warm_[shape * objects_.size() + reinterpret_cast<std::size_t>(obstacle.getUserData())];
 }
 
-double World::distance(coal::CollisionObject& object) {
-  coal::DistanceCallBackDefault callback;
-  callback.data.request.enable_nearest_points = false;
-  // an overlap only needs to be known (clearance 0), not measured: no EPA
-  callback.data.request.enable_signed_distance = false;
-  tune(callback.data.request);
-  callback.init();
-  manager_->distance(&object, &callback);
-  const double d = callback.data.result.min_distance;
+bool World::collides(coal::CollisionObject& object, std::size_t shape) {
+  CollideNear near;
+  near.world = this;
+  near.query = &object;
+  near.shape = shape;
+  manager_->collide(&object, &near);
+  return near.hit;
+}
+
+double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
+                            coal::CollisionObject& obstacle, coal::DistanceRequest& request,
+                            coal::DistanceResult& result) {
+  WarmStart& w = warm(shape, obstacle);
+  request.cached_gjk_guess = w.guess;
+  request.cached_support_func_guess = w.hint;
+  result.clear();
+  const double d = coal::distance(&object, &obstacle, request, result);
+  w.guess = result.cached_gjk_guess;
+  w.hint = result.cached_support_func_guess;
   return d > 0.0 ? d : 0.0;  // an overlap, or anything coal cannot tell (NaN): no clearance
+}
+
+double World::distance(coal::CollisionObject& object, std::size_t shape) {
+  DistanceNear near;
+  near.world = this;
+  near.query = &object;
+  near.shape = shape;
+  manager_->distance(&object, &near);
+  return near.best;
 }
 
 bool World::in_collision(const Pose& pose) {
@@ -329,7 +403,7 @@ bool World::in_collision(const Pose& pose) {
   if (objects_.empty()) return false;
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     count_body(k);
-    if (collides(*bodies_[k])) return true;
+    if (collides(*bodies_[k], k)) return true;
   }
   return false;
 }
@@ -343,7 +417,7 @@ void World::body_distances(const Pose& pose, double* out) {
       continue;
     }
     count_body(k);
-    out[k] = distance(*bodies_[k]);
+    out[k] = distance(*bodies_[k], k);
   }
 }
 
@@ -362,8 +436,7 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
     for (FreeRegion& r : out) r.horizon = std::numeric_limits<double>::infinity();
     return true;
   }
-  coal::DistanceRequest request(true, false);  // nearest points; an overlap is not measured
-  tune(request);
+  coal::DistanceRequest request = distance_request(/*nearest_points=*/true);
   coal::DistanceResult result;
   const double keep = 1.0 - rtol_;
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
@@ -389,12 +462,11 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
     FreeRegion& region = out[k];
     if (near_.empty()) {  // open space: the clearance to everything is the better horizon
       ++counters.distance_queries;
-      region.horizon = std::max(horizon, distance(body) * keep - atol_);
+      region.horizon = std::max(horizon, distance(body, k) * keep - atol_);
       continue;
     }
     for (coal::CollisionObject* obstacle : near_) {
-      result.clear();
-      const double d = coal::distance(&body, obstacle, request, result);
+      const double d = pair_distance(body, k, *obstacle, request, result);
       if (!(d > 0.0)) {
         for (FreeRegion& r : out) r.planes.clear(), r.horizon = 0.0;
         return false;
@@ -429,7 +501,7 @@ bool World::ball_collides(const std::array<double, 3>& centre, double radius) {
                              coal::Transform3s(coal::Matrix3s::Identity(),
                                                Vec3s(centre[0], centre[1], centre[2])));
   ball.computeAABB();
-  return collides(ball);
+  return collides(ball, core_shape());
 }
 
 bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,
@@ -450,7 +522,7 @@ bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array
   coal::CollisionObject capsule(std::make_shared<coal::Capsule>(radius, length),
                                 coal::Transform3s(R, 0.5 * (p + q)));
   capsule.computeAABB();
-  return collides(capsule);
+  return collides(capsule, core_shape());
 }
 
 }  // namespace kcplan

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <coal/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <coal/collision_data.h>
 #include <coal/collision_object.h>
 
 #include "pose.hpp"
@@ -60,7 +61,14 @@ struct WorldCounters {
 /// robot pose and throw std::invalid_argument for a pose that is not finite. Distances of
 /// `safe_*` queries are reduced by coal's error allowance, `d (1 - rtol) - atol`, and are
 /// never overestimates (the allowance is justified in kcplan/_kernel/__init__.py).
-/// Not thread-safe: the robot's coal objects and the solvers are reused between queries.
+/// Not thread-safe: the robot's coal objects, the solvers and GJK's warm starts are reused
+/// between queries.
+///
+/// Every narrow-phase query of a (robot shape, obstacle) pair starts GJK where the pair's
+/// last query ended (its last direction and support vertices): hill-climbing over a
+/// polytope's vertices then begins next to the answer instead of at vertex 0. The start
+/// changes only how fast GJK converges, never its stopping test, so verdicts and the
+/// distance error bound are those of a cold start.
 class World {
  public:
   World(const Robot& robot, double half_height, double rtol, double atol);
@@ -124,11 +132,28 @@ class World {
     double operator()(const double* n) const;
   };
 
+  /// Where GJK ended for one (robot shape, obstacle) pair: its last direction and the
+  /// support vertices of both shapes (indices into that pair's polytopes only).
+  struct WarmStart {
+    coal::Vec3s guess = coal::Vec3s(1.0, 0.0, 0.0);
+    coal::support_func_guess_t hint = coal::support_func_guess_t::Zero();
+  };
+  struct CollideNear;
+  struct DistanceNear;
+
   void add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
            const coal::Transform3s& transform, Support support);
   void place(const Pose& pose);
-  bool collides(coal::CollisionObject& object);
-  double distance(coal::CollisionObject& object);
+  /// `shape` is the row of warm starts: a body's index, or core_shape() for a ball or capsule.
+  bool collides(coal::CollisionObject& object, std::size_t shape);
+  double distance(coal::CollisionObject& object, std::size_t shape);
+  /// The distance of one pair (0 for an overlap or what coal cannot tell), warm-started;
+  /// `result` keeps coal's nearest points.
+  double pair_distance(coal::CollisionObject& object, std::size_t shape,
+                       coal::CollisionObject& obstacle, coal::DistanceRequest& request,
+                       coal::DistanceResult& result);
+  WarmStart& warm(std::size_t shape, const coal::CollisionObject& obstacle);
+  std::size_t core_shape() const { return bodies_.size(); }
   void count_body(std::size_t k);
 
   Robot robot_;
@@ -141,6 +166,7 @@ class World {
   std::vector<double> horizon_sides_;
   std::unique_ptr<coal::DynamicAABBTreeCollisionManager> manager_;
   std::vector<coal::CollisionObject*> near_;
+  std::vector<WarmStart> warm_;  // (bodies + 1) x obstacles; the last row: ball and capsule
   bool finalized_ = false;
 };
 
