@@ -26,6 +26,7 @@ from kcplan._kernel import EdgeCertifier as CompiledCertifier
 from kcplan._kernel import Robot as KernelRobot
 from kcplan._kernel import World as KernelWorld
 from kcplan.geometry.pose import Edge, quaternion_multiply, wrap_angle
+from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.planning.certifier import CERTIFICATE_SETS, COUNTER_NAMES, EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
@@ -78,20 +79,24 @@ def _thin_walls() -> Scenario:
     return parse_scenario(data, check=False)
 
 
+THREE_BODIES = {
+    "bodies": [
+        {"semi_axes": [2.0, 1.2, 1.0]},
+        {
+            "semi_axes": [1.5, 0.5, 0.5],
+            "position": [2.5, 1.0, 0.0],
+            "quaternion": [0.0, 0.0, 0.3826834, 0.9238795],
+        },
+        {"semi_axes": [1.0, 1.0, 0.4], "position": [-2.0, 0.0, 1.0]},
+    ]
+}
+"""A robot of three ellipsoids, the first at the origin (a core)."""
+
+
 def _bodies_3d() -> Scenario:
     """Three ellipsoids (the first at the origin: a core) among random clutter with thin
     rotated walls, rotated ellipsoids, balls and boxes."""
-    robot = {
-        "bodies": [
-            {"semi_axes": [2.0, 1.2, 1.0]},
-            {
-                "semi_axes": [1.5, 0.5, 0.5],
-                "position": [2.5, 1.0, 0.0],
-                "quaternion": [0.0, 0.0, 0.3826834, 0.9238795],
-            },
-            {"semi_axes": [1.0, 1.0, 0.4], "position": [-2.0, 0.0, 1.0]},
-        ]
-    }
+    robot = THREE_BODIES
     obstacles = random_obstacles(np.random.default_rng(12), 3, 16, 20.0)
     data = _scenario_dict("bodies_3d", 3, ([-25] * 3, [25] * 3), robot, obstacles)
     return parse_scenario(data, check=False)
@@ -260,6 +265,60 @@ def test_kernel_collision_verdicts_agree_with_python_fcl(name):
         elif world.clearance(pose) > near:
             assert not compiled, pose
     assert 0 < hits < len(poses)  # both kinds of state were drawn
+
+
+def _superquadric_world() -> Scenario:
+    """Three superquadric polytopes of about 1,000 vertices each (where GJK hill-climbs
+    over vertex neighbours) around three ellipsoids, inside a mesh-free box field."""
+    obstacles = []
+    for i, (e, axes) in enumerate([(0.3, [6, 3, 2]), (0.6, [2, 5, 3]), (1.0, [4, 4, 1])]):
+        outer = bounding_polytopes(axes, e, count=500).outer
+        obstacles.append({"convex": {"vertices": outer.tolist(), "position": [9.0 * (i - 1), 0, 0]}})
+    obstacles += random_obstacles(np.random.default_rng(13), 3, 6, 20.0)
+    data = _scenario_dict("superquadrics", 3, ([-25] * 3, [25] * 3), THREE_BODIES, obstacles)
+    return parse_scenario(data, check=False)
+
+
+@pytest.mark.parametrize("name", ["slanted_gap", "l_robot_door", "open_space", "superquadrics"])
+def test_warm_started_queries_answer_as_cold_ones(name):
+    """Every narrow-phase query starts GJK where its pair's last one ended. Along random
+    walks (the coherence of a planner's queries) and random jumps, the warm world's
+    collision verdicts equal those of a world built afresh for every pose, its distances
+    and region clearances agree to GJK's tolerance, and its region planes are the same
+    pieces."""
+    scenario = _superquadric_world() if name == "superquadrics" else _scenario(name)
+    fcl_world = CollisionWorld(scenario)
+    build = _kernel.build_kernel_world  # a new world: every pair starts cold
+    args = (scenario, fcl_world.robot, fcl_world._half_height)
+    warm = build(*args)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    n = scenario.dimension
+    horizon = float(fcl_world.robot.largest_semi_axis)
+    low, high = scenario.bounds
+    step_length = 0.03 * float(np.ptp(scenario.bounds, axis=0).max())
+    hits = planes = 0
+    for step in range(240):
+        if step % 40 == 0:  # a jump: warm starts from far away
+            pose = np.concatenate([rng.uniform(low, high), random_pose(rng, n, 0, 1)[n:]])
+        else:
+            pose = np.concatenate([pose[:n] + rng.normal(0.0, step_length, n), _turn(rng, pose, n)])
+        p = pose.tolist()
+        cold = build(*args)
+        hit = warm.in_collision(p)
+        assert hit == cold.in_collision(p), (step, p)
+        hits += hit
+        d_warm, d_cold = np.array(warm.body_distances(p)), np.array(build(*args).body_distances(p))
+        np.testing.assert_allclose(d_warm, d_cold, rtol=1e-5, atol=1e-6, err_msg=str(p))
+        free_warm, regions_warm = warm.free_regions(p, horizon)
+        free_cold, regions_cold = build(*args).free_regions(p, horizon)
+        assert free_warm == free_cold
+        for (pw, hw), (pc, hc) in zip(regions_warm, regions_cold, strict=True):
+            assert len(pw) == len(pc)
+            assert hw == pytest.approx(hc, rel=1e-5, abs=1e-6)
+            for a, b in zip(pw, pc, strict=True):
+                assert a[4] == pytest.approx(b[4], rel=1e-5, abs=1e-6)  # clearance
+                planes += 1
+    assert 0 < hits < 240 and planes > 0  # both kinds of pose, and planes, were met
 
 
 @pytest.mark.parametrize("name", sorted(SETS))
