@@ -273,7 +273,9 @@ def _superquadric_world() -> Scenario:
     obstacles = []
     for i, (e, axes) in enumerate([(0.3, [6, 3, 2]), (0.6, [2, 5, 3]), (1.0, [4, 4, 1])]):
         outer = bounding_polytopes(axes, e, count=500).outer
-        obstacles.append({"convex": {"vertices": outer.tolist(), "position": [9.0 * (i - 1), 0, 0]}})
+        obstacles.append(
+            {"convex": {"vertices": outer.tolist(), "position": [9.0 * (i - 1), 0, 0]}}
+        )
     obstacles += random_obstacles(np.random.default_rng(13), 3, 6, 20.0)
     data = _scenario_dict("superquadrics", 3, ([-25] * 3, [25] * 3), THREE_BODIES, obstacles)
     return parse_scenario(data, check=False)
