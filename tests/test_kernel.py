@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import trimesh
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from ompl import base as ob
@@ -35,6 +36,7 @@ from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import verify_path
 from kcplan.world import CollisionWorld, Scenario, load_scenario, parse_scenario
 from kcplan.world.clutter import random_obstacles, random_pose
+from kcplan.world.collision import CLEARANCE_RTOL
 
 ROOT = Path(__file__).resolve().parent.parent
 NAN, INF = math.nan, math.inf
@@ -321,6 +323,53 @@ def test_warm_started_queries_answer_as_cold_ones(name):
                 assert a[4] == pytest.approx(b[4], rel=1e-5, abs=1e-6)  # clearance
                 planes += 1
     assert 0 < hits < 240 and planes > 0  # both kinds of pose, and planes, were met
+
+
+def _arena_world(directory: Path) -> Scenario:
+    """Three ellipsoids inside a convex arena mesh (an icosphere stretched to 40 x 24 x 16
+    semi-axes, 1,280 triangles, as HRM's inscribed arenas), with a box, a ball and a
+    wall inside: where the kernel reads distances off the mesh's planes."""
+    arena = trimesh.creation.icosphere(subdivisions=3)
+    arena.apply_scale([40.0, 24.0, 16.0])
+    arena.export(directory / "arena.stl")
+    obstacles = [
+        {"mesh": {"file": "arena.stl"}},
+        {"box": {"center": [10, 0, 0], "size": [4, 6, 3], "quaternion": _unit([0.2, 0.1, 0.3, 1])}},
+        {"sphere": {"center": [-12, 5, -2], "radius": 3}},
+        {"box": {"center": [-2, -8, 0], "size": [0.1, 8, 10]}},
+    ]
+    data = _scenario_dict("arena", 3, ([-36, -20, -13], [36, 20, 13]), THREE_BODIES, obstacles)
+    return parse_scenario(data, directory=directory, check=False)
+
+
+def test_distances_read_off_a_convex_arena_agree_with_python_fcl(tmp_path):
+    """Inside a convex mesh the kernel proves bodies clear, and measures them, on the
+    triangles' planes instead of coal's BVH: its verdicts are python-fcl's (away from
+    contact), its distances python-fcl's to FCL's error, and never above them by more
+    than that error (a clearance must not be overestimated)."""
+    scenario = _arena_world(tmp_path)
+    world = CollisionWorld(scenario)
+    rng = np.random.default_rng(5)
+    low, high = scenario.bounds
+    near = 1e-6 * float(np.ptp(scenario.bounds, axis=0).max())
+    hits = close_calls = 0
+    for _ in range(1500):
+        pose = np.concatenate([rng.uniform(low, high), random_pose(rng, 3, 0, 1)[3:]])
+        fcl_free = not world.in_collision(pose)
+        compiled = world.kernel.in_collision(pose.tolist())
+        fcl_d = world.body_clearances(pose)
+        if not fcl_free:
+            hits += 1
+            assert compiled, pose
+            continue
+        if fcl_d.min() > near:
+            assert not compiled, pose
+        kernel_d = np.array(world.kernel.body_distances(pose.tolist()))
+        allowance = 2 * CLEARANCE_RTOL * fcl_d + 1e-6
+        np.testing.assert_array_less(kernel_d, fcl_d + allowance, err_msg=str(pose))
+        np.testing.assert_array_less(fcl_d, kernel_d + allowance, err_msg=str(pose))
+        close_calls += int(np.any(kernel_d < 6.0))
+    assert 0 < hits < 1500 and close_calls > 100
 
 
 @pytest.mark.parametrize("name", sorted(SETS))

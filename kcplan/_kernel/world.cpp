@@ -134,6 +134,9 @@ struct World::CollideNear : coal::CollisionCallBackBase {
   coal::CollisionResult result;
   bool collide(coal::CollisionObject* o1, coal::CollisionObject* o2) override {
     coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
+    if (const auto bound = world->plane_bound(*query, *obstacle, false);
+        bound && bound->value > 0.0)
+      return false;  // clear of every triangle's plane: clear of the mesh
     WarmStart& w = world->warm(shape, *obstacle);
     request.cached_gjk_guess = w.guess;
     request.cached_support_func_guess = w.hint;
@@ -228,6 +231,7 @@ void World::add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
   object->computeAABB();
   object->setUserData(reinterpret_cast<void*>(supports_.size()));
   supports_.push_back(std::move(support));
+  planes_.emplace_back();
   objects_.push_back(std::move(object));
 }
 
@@ -339,6 +343,8 @@ void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>
   model->endModel();
   model->computeLocalAABB();
   add(model, coal::Transform3s::Identity(), Support{});
+  auto planes = std::make_unique<const MeshPlanes>(points, faces);
+  if (planes->usable()) planes_.back() = std::move(planes);
 }
 
 void World::finalize() {
@@ -375,6 +381,15 @@ void World::count_body(std::size_t k) {
   ++body_query_counts[k];
 }
 
+std::optional<MeshPlanes::Bound> World::plane_bound(const coal::CollisionObject& query,
+                                                    const coal::CollisionObject& obstacle,
+                                                    bool measure) const {
+  const MeshPlanes* planes = planes_[reinterpret_cast<std::size_t>(obstacle.getUserData())].get();
+  ShapeSupport support;
+  if (planes == nullptr || !ShapeSupport::of(query, support)) return std::nullopt;
+  return planes->bound(support, measure);
+}
+
 World::WarmStart& World::warm(std::size_t shape, const coal::CollisionObject& obstacle) {
   return warm_[shape * objects_.size() + reinterpret_cast<std::size_t>(obstacle.getUserData())];
 }
@@ -391,6 +406,9 @@ bool World::collides(coal::CollisionObject& object, std::size_t shape) {
 double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
                             coal::CollisionObject& obstacle, coal::DistanceRequest& request,
                             coal::DistanceResult& result) {
+  if (const auto bound = plane_bound(object, obstacle, true);
+      bound && bound->value > 0.0 && bound->exact)
+    return bound->value;
   WarmStart& w = warm(shape, obstacle);
   request.cached_gjk_guess = w.guess;
   request.cached_support_func_guess = w.hint;
@@ -486,11 +504,14 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
       }
       Plane plane;
       plane.clearance = std::max(d * keep - atol_, 0.0);
-      const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];
-      double v[3] = {dir[0], dir[1], dimension_ == 3 ? dir[2] : 0.0};
-      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       const Support& support =
           supports_[reinterpret_cast<std::size_t>(obstacle->getUserData())];
+      double v[3] = {0.0, 0.0, 0.0};
+      if (support.kind != Support::kNone) {  // a mesh's distance may come without points
+        const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];
+        v[0] = dir[0], v[1] = dir[1], v[2] = dimension_ == 3 ? dir[2] : 0.0;
+      }
+      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       if (support.kind == Support::kNone || !(length > 0.0) || !std::isfinite(length)) {
         plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
         plane.offset = std::numeric_limits<double>::infinity();

@@ -6,12 +6,14 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <coal/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <coal/collision_data.h>
 #include <coal/collision_object.h>
 
+#include "mesh_planes.hpp"
 #include "pose.hpp"
 #include "robot.hpp"
 
@@ -56,6 +58,9 @@ struct WorldCounters {
 /// Convex pieces are coal convex polytopes with vertex neighbours (GJK hill-climbs over
 /// them); meshes are BVH surfaces (a body wholly inside a closed mesh is reported free, as
 /// with FCL). Every convex piece keeps its exact support function for region queries.
+/// A mesh also keeps its triangles' planes (MeshPlanes): a shape on the inner side of all
+/// of them is proven clear without the BVH, and its distance is read off the planes when
+/// the bound is exact (a robot inside a convex arena); otherwise coal's BVH answers.
 ///
 /// Contract: obstacles are added, then `finalize()` registers them once; queries take a
 /// robot pose and throw std::invalid_argument for a pose that is not finite. Distances of
@@ -153,6 +158,12 @@ class World {
                        coal::CollisionObject& obstacle, coal::DistanceRequest& request,
                        coal::DistanceResult& result);
   WarmStart& warm(std::size_t shape, const coal::CollisionObject& obstacle);
+  /// The planes' bound of a mesh obstacle for `query` (MeshPlanes::bound); no value when
+  /// the obstacle is not a mesh (or its planes are unusable) or the query shape has no
+  /// support here.
+  std::optional<MeshPlanes::Bound> plane_bound(const coal::CollisionObject& query,
+                                               const coal::CollisionObject& obstacle,
+                                               bool measure) const;
   std::size_t core_shape() const { return bodies_.size(); }
   void count_body(std::size_t k);
 
@@ -161,6 +172,7 @@ class World {
   double half_height_, rtol_, atol_;
   std::vector<std::unique_ptr<coal::CollisionObject>> objects_;
   std::vector<Support> supports_;
+  std::vector<std::unique_ptr<const MeshPlanes>> planes_;  // per obstacle; null: not a mesh
   std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
   std::vector<std::unique_ptr<coal::CollisionObject>> horizon_boxes_;
   std::vector<double> horizon_sides_;
