@@ -1,10 +1,13 @@
 """Cost of one collision query and one clearance query per scenario, python-fcl and kernel.
 
-Times ``CollisionWorld.in_collision`` and ``CollisionWorld.clearance`` (python-fcl), and
-the compiled kernel's collision query as a stock state check makes it
-(``World.in_collision_se2`` / ``_se3``, coal), at random poses inside each scenario's
+Times ``CollisionWorld.in_collision`` and ``CollisionWorld.clearance`` (python-fcl), the
+compiled kernel's collision query as a stock state check makes it
+(``World.in_collision_se2`` / ``_se3``, coal), and the kernel's distance query
+(``World.body_distances``) and region query (``World.free_regions`` with the certifier's
+default horizon, the robot's largest semi-axis), at random poses inside each scenario's
 bounds (fixed seed), in repeated blocks, and prints the median time per query over
-blocks, in microseconds::
+blocks, in microseconds. Collision queries are timed at all poses (those that collide
+stop early), distance and region queries at the free ones (as the certifier asks)::
 
     python scripts/bench_queries.py scenarios/*/*.yaml [--poses 2000] [--blocks 7]
 """
@@ -47,7 +50,8 @@ def main() -> None:
     rng = np.random.default_rng(0)
     print(
         f"{'scenario':<18} {'fcl objects':>11} {'collision us':>13} "
-        f"{'clearance us':>13} {'ratio':>6} {'kernel collision us':>20}"
+        f"{'clearance us':>13} {'ratio':>6} {'kernel collision us':>20} "
+        f"{'kernel distance us':>19} {'kernel region us':>17}"
     )
     for path in args.scenarios:
         scenario = load_scenario(path)
@@ -59,9 +63,13 @@ def main() -> None:
         fast = kernel.in_collision_se2 if scenario.dimension == 2 else kernel.in_collision_se3
         rows = [p.tolist() for p in poses]  # plain floats, as the state checker passes
         k = per_query_us(lambda p, fast=fast: fast(*p), rows, args.blocks)
+        free = [p for p in rows if not kernel.in_collision(p)] or rows
+        kd = per_query_us(kernel.body_distances, free, args.blocks)
+        horizon = float(world.robot.largest_semi_axis)
+        kr = per_query_us(lambda p, h=horizon: kernel.free_regions(p, h), free, args.blocks)
         print(
             f"{scenario.name:<18} {world.n_objects:>11} {c:>13.1f} {d:>13.1f} {d / c:>6.2f} "
-            f"{k:>20.2f}"
+            f"{k:>20.2f} {kd:>19.2f} {kr:>17.2f}"
         )
 
 

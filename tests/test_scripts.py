@@ -83,8 +83,9 @@ CASES = [
         "bench_queries.py",
         (CORRIDOR, "--poses", "50", "--blocks", "1"),
         (
-            r"kernel collision us",
-            rf"narrow_corridor\s+2\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}$",
+            r"kernel collision us\s+kernel distance us\s+kernel region us",
+            rf"narrow_corridor\s+2\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}\s+{NUMBER}"
+            rf"\s+{NUMBER}\s+{NUMBER}$",
         ),
     ),
     *(
