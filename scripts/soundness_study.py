@@ -3,7 +3,10 @@
 Random worlds of thin rotated walls, balls, boxes and ellipsoids
 (:mod:`kcplan.world.clutter`; 2D and 3D, several robot shapes),
 random edges from a free state closer to an obstacle than the robot's size (short, medium
-and long, with and without rotation), each decided by the certifier (``--backend
+and long, with and without rotation); with ``--arena`` each 3D world is also enclosed in a
+convex mesh (a stretched icosphere of 1,280 triangles, semi-axes 26 to 34, so that some
+robot poses reach or leave it: the kernel's mesh planes and coal's BVH both decide), each
+decided by the certifier (``--backend
 kernel``: the compiled :class:`kcplan.planning.kernel.KernelCertifier`, the default;
 ``python``: the Python :class:`kcplan.planning.certifier.EdgeCertifier`) with every
 certificate set of the ablation (``ca``, ``kc-paper``, ``kc``). Every accepted edge is
@@ -14,22 +17,25 @@ edge rejected* is a rejected edge the check finds free (the price of proving). P
 Markdown table::
 
     python scripts/soundness_study.py [--edges 100000] [--seed 1] [--dimensions 2 3] \
-        [--backend kernel]
+        [--backend kernel] [--arena]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 import numpy as np
+import trimesh
 
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld
+from kcplan.world import CollisionWorld, Scenario
 from kcplan.world.clutter import random_pose, random_scenario
+from kcplan.world.scenario import Obstacle
 
 SHAPES = {
     2: ([5.0, 3.5], [1.0, 0.4], [3.0, 3.0], [8.0, 1.0]),
@@ -44,7 +50,20 @@ def certifier(backend: str, world, a, kinds, ladder):
     return EdgeCertifier(world, a, kinds, ladder)
 
 
-def study(n: int, edges: int, rng: np.random.Generator, backend: str = "kernel") -> dict:
+def with_arena(scenario: Scenario, rng: np.random.Generator) -> Scenario:
+    """``scenario`` inside a convex mesh: an icosphere stretched to random semi-axes."""
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    vertices = sphere.vertices * rng.uniform(26.0, 34.0, 3)
+    arena = Obstacle(
+        "mesh", len(scenario.obstacles), {"file": "arena"}, np.zeros(3), np.eye(3),
+        np.zeros(3), (), vertices, np.asarray(sphere.faces),
+    )  # fmt: skip
+    return dataclasses.replace(scenario, obstacles=(*scenario.obstacles, arena))
+
+
+def study(
+    n: int, edges: int, rng: np.random.Generator, backend: str = "kernel", arena: bool = False
+) -> dict:
     """Counts per certificate set for ``edges`` random edges in ``n`` dimensions."""
     counts = {
         name: dict.fromkeys(("accepted", "violations", "free_rejected"), 0)
@@ -53,7 +72,8 @@ def study(n: int, edges: int, rng: np.random.Generator, backend: str = "kernel")
     done = 0
     while done < edges:
         a = SHAPES[n][int(rng.integers(len(SHAPES[n])))]
-        world = CollisionWorld(random_scenario(rng, n, a, int(rng.integers(6, 16))))
+        scenario = random_scenario(rng, n, a, int(rng.integers(6, 16)))
+        world = CollisionWorld(with_arena(scenario, rng) if arena and n == 3 else scenario)
         ladder = GuardLadder(a)
         certifiers = {
             name: certifier(backend, world, a, kinds, ladder if "polytope" in kinds else None)
@@ -91,13 +111,14 @@ def main() -> None:
         default="kernel",
         help="who certifies: the compiled kernel (default) or the Python certifier",
     )
+    parser.add_argument("--arena", action="store_true", help="enclose each 3D world in a mesh")
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     print("| dimension | certificates | edges | accepted | violations | free edges rejected |")
     print("|---|---|---|---|---|---|")
     for n in args.dimensions:
         t0 = time.perf_counter()
-        counts = study(n, args.edges, rng, args.backend)
+        counts = study(n, args.edges, rng, args.backend, args.arena)
         for name, c in counts.items():
             print(
                 f"| {n}D | {name} | {args.edges} | {c['accepted']} | {c['violations']} "

@@ -216,11 +216,15 @@ CASES = [
     *(
         Case(
             "soundness_study.py",
-            ("--edges", "100", "--backend", backend),
+            ("--edges", "100", "--backend", backend, *extra),
             (r"\| dimension \| certificates \| edges \|",),
             check=_no_violation,
         )
-        for backend in ("kernel", "python")
+        for backend, extra in (
+            ("kernel", ()),
+            ("python", ()),
+            ("kernel", ("--dimensions", "3", "--arena")),
+        )
     ),
 ]
 

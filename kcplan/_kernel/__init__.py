@@ -16,6 +16,8 @@ C++ (``kcplan/_kernel/``)          Python twin
 ``guard.hpp``                      :mod:`kcplan.planning.guard`
 ``certificates.hpp``               :mod:`kcplan.planning.certificates`
 ``certifier.hpp`` ``EdgeCertifier`` :mod:`kcplan.planning.certifier`
+``mesh_planes.hpp`` ``MeshPlanes``   none: python-fcl measures meshes with
+                                  FCL's BVH; tested against it
 ================================= ==========================================
 
 Conventions: poses are flat, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]`` (scalar

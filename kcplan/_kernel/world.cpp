@@ -126,9 +126,10 @@ coal::CollisionRequest collision_request() {
 /// The broad phase's candidates for one query shape, each tried with its pair's warm
 /// start; stops at the first obstacle that touches the shape.
 struct World::CollideNear : coal::CollisionCallBackBase {
-  World* world = nullptr;
-  coal::CollisionObject* query = nullptr;
-  std::size_t shape = 0;
+  CollideNear(World* w, coal::CollisionObject* q, std::size_t s) : world(w), query(q), shape(s) {}
+  World* world;
+  coal::CollisionObject* query;
+  std::size_t shape;
   bool hit = false;
   coal::CollisionRequest request = collision_request();
   coal::CollisionResult result;
@@ -152,9 +153,10 @@ struct World::CollideNear : coal::CollisionCallBackBase {
 /// The smallest distance of one query shape to the broad phase's candidates, which the
 /// broad phase uses to prune; stops at contact.
 struct World::DistanceNear : coal::DistanceCallBackBase {
-  World* world = nullptr;
-  coal::CollisionObject* query = nullptr;
-  std::size_t shape = 0;
+  DistanceNear(World* w, coal::CollisionObject* q, std::size_t s) : world(w), query(q), shape(s) {}
+  World* world;
+  coal::CollisionObject* query;
+  std::size_t shape;
   double best = std::numeric_limits<double>::infinity();
   coal::DistanceRequest request = distance_request(false);
   coal::DistanceResult result;
@@ -395,10 +397,7 @@ World::WarmStart& World::warm(std::size_t shape, const coal::CollisionObject& ob
 }
 
 bool World::collides(coal::CollisionObject& object, std::size_t shape) {
-  CollideNear near;
-  near.world = this;
-  near.query = &object;
-  near.shape = shape;
+  CollideNear near(this, &object, shape);
   manager_->collide(&object, &near);
   return near.hit;
 }
@@ -420,10 +419,7 @@ double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
 }
 
 double World::distance(coal::CollisionObject& object, std::size_t shape) {
-  DistanceNear near;
-  near.world = this;
-  near.query = &object;
-  near.shape = shape;
+  DistanceNear near(this, &object, shape);
   manager_->distance(&object, &near);
   return near.best;
 }
