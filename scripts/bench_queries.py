@@ -66,7 +66,8 @@ def main() -> None:
         free = [p for p in rows if not kernel.in_collision(p)] or rows
         kd = per_query_us(kernel.body_distances, free, args.blocks)
         horizon = float(world.robot.largest_semi_axis)
-        kr = per_query_us(lambda p, h=horizon: kernel.free_regions(p, h), free, args.blocks)
+        regions = kernel.free_regions
+        kr = per_query_us(lambda p, h=horizon, f=regions: f(p, h), free, args.blocks)
         print(
             f"{scenario.name:<18} {world.n_objects:>11} {c:>13.1f} {d:>13.1f} {d / c:>6.2f} "
             f"{k:>20.2f} {kd:>19.2f} {kr:>17.2f}"

@@ -4,15 +4,19 @@ Plans one scenario with one seed (no simplification) and prints one Markdown row
 
     python scripts/edge_cost.py scenarios/2d/slanted_gap.yaml kc-rrtconnect-py 1
 
+Columns: scenario, planner, seed, solve seconds, certified edges, queries, solve µs per
+certified edge, µs per call, seconds outside the calls.
+
 For a planner on the Python backend (``kc-*-py``, ``*-fcl``) the FCL queries are timed per
 type the run used (collision, clearance, region) at 1,000 random free poses of the same
-map, and the last column is the remaining (Python) time per certified edge or state
-check. For a planner on the compiled kernel (``kc-*``, stock planners) the FCL queries
-column holds the kernel world's query counts (coal) and the last column is the time spent
-in the validator's and the state checker's calls (reading the OMPL states and the one
-call into the kernel; timed around each call, which adds about 0.1 µs) per certified edge
-or state check: the rest of the solve time is OMPL's own work (sampling, nearest
-neighbours, tree bookkeeping).
+map, and "µs per call" is the remaining (Python) time per certified edge or state check.
+For a planner on the compiled kernel (``kc-*``, stock planners) the queries column holds
+the kernel world's query counts (coal) and "µs per call" is the time spent in the
+validator's and the state checker's calls (reading the OMPL states and the one call into
+the kernel; timed around each call, which adds about 0.1 µs) per certified edge or state
+check. The rest of the solve time is OMPL's own work (sampling, nearest neighbours, tree
+bookkeeping, the calls' way in and out of Python): the last column, in seconds (``-`` on
+the Python backend). No validator, however fast, makes the run shorter than that.
 
 Run it from another checkout (``PYTHONPATH=OTHER python scripts/edge_cost.py ...``) to
 compare two versions of the validator on the same seeds.
@@ -124,14 +128,16 @@ def main() -> None:
     if r.backend == "python":
         queries = c["fcl_queries"]
         rest = r.time - fcl_time(scenario, world, c, args.poses)
+        outside = "-"
     else:
         kernel = world.kernel.counters
         queries = sum(kernel[key] for key in QUERY_KEYS)
         rest = timer.seconds
+        outside = f"{max(r.time - timer.seconds, 0.0):.3f}"
     per_edge = f"{1e6 * r.time / edges:.1f}" if edges else "-"  # a stock planner has none
     print(
         f"| {scenario.name} | {args.planner} | {args.seed} | {r.time:.3f} | {edges} "
-        f"| {queries} | {per_edge} | {1e6 * rest / calls:.1f} |"
+        f"| {queries} | {per_edge} | {1e6 * rest / calls:.1f} | {outside} |"
     )
 
 

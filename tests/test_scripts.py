@@ -135,7 +135,7 @@ CASES = [
             (CORRIDOR, planner, "1", "--poses", "200", "--time", "5"),
             (
                 rf"^\| narrow_corridor \| {planner} \| 1 \| {NUMBER} \| [1-9]\d* \| [1-9]\d* "
-                rf"\| {NUMBER} \| {NUMBER} \|$",
+                rf"\| {NUMBER} \| {NUMBER} \| ({NUMBER}|-) \|$",
             ),
         )
         for planner in ("kc-rrtconnect", "kc-rrtconnect-py")
