@@ -7,8 +7,6 @@ differences are the planner and, for the ``kc-*`` planners, the motion validator
 
 from __future__ import annotations
 
-import contextlib
-import gc
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -245,23 +243,6 @@ class PlanResult:
         }
 
 
-@contextlib.contextmanager
-def _frozen_heap():
-    """Keep Python's garbage collector off the objects that exist before ``solve()``.
-
-    Every state check and ``checkMotion`` is a Python call from OMPL's C++ loop; the
-    objects those calls allocate trigger the collector, whose older generations would
-    traverse the whole loaded world (modules, scenario, meshes) again and again. Frozen
-    objects are skipped until they are unfrozen afterwards; what ``solve()`` allocates is
-    still collected as usual.
-    """
-    gc.freeze()
-    try:
-        yield
-    finally:
-        gc.unfreeze()
-
-
 def plan(
     scenario: Scenario,
     planner: str = "kc-rrtconnect",
@@ -361,8 +342,7 @@ def plan(
     else:
         stop = ob.timedPlannerTerminationCondition(float(time_limit))
     try:
-        with _frozen_heap():
-            ss.solve(stop)
+        ss.solve(stop)
         if recorder is not None:
             recorder.finish()
         if validator is not None:
