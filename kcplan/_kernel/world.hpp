@@ -70,10 +70,10 @@ struct WorldCounters {
 /// between queries.
 ///
 /// Every narrow-phase query of a (robot shape, obstacle) pair starts GJK where the pair's
-/// last query ended (its last direction and support vertices): hill-climbing over a
-/// polytope's vertices then begins next to the answer instead of at vertex 0. The start
-/// changes only how fast GJK converges, never its stopping test, so verdicts and the
-/// distance error bound are those of a cold start.
+/// last query ended (its last direction and support vertices): for nearby poses GJK then
+/// starts next to the answer, and its hill-climbing over a polytope's vertices starts
+/// next to the support point. The start changes only how fast GJK converges, never its
+/// stopping test, so verdicts and the distance error bound are those of a cold start.
 class World {
  public:
   World(const Robot& robot, double half_height, double rtol, double atol);
