@@ -223,7 +223,7 @@ CASES = [
         for backend, extra in (
             ("kernel", ()),
             ("python", ()),
-            ("kernel", ("--dimensions", "3", "--arena")),
+            ("kernel", ("--arena",)),  # 3D worlds inside a convex mesh
         )
     ),
 ]
