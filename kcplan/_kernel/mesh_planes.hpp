@@ -2,12 +2,11 @@
 // convex shape to the mesh, found without the BVH when the shape lies on the inner side
 // of every plane (a robot inside a convex arena, as in HRM's maps).
 // Python twin: none; the python-fcl world measures meshes with FCL's BVH, and the tests
-// compare this bound with coal's BVH distances and with python-fcl (tests/test_kernel.py).
+// compare the kernel's verdicts and distances inside a convex arena with python-fcl's
+// (tests/test_kernel.py).
 #pragma once
 
 #include <algorithm>
-#include <array>
-#include <utility>
 #include <cmath>
 #include <limits>
 #include <vector>
