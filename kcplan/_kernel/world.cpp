@@ -139,12 +139,10 @@ struct World::CollideNear : coal::CollisionCallBackBase {
         bound && bound->value > 0.0)
       return false;  // clear of every triangle's plane: clear of the mesh
     WarmStart& w = world->warm(shape, *obstacle);
-    request.cached_gjk_guess = w.guess;
-    request.cached_support_func_guess = w.hint;
+    w.start(request);
     result.clear();
     coal::collide(query, obstacle, request, result);
-    w.guess = result.cached_gjk_guess;
-    w.hint = result.cached_support_func_guess;
+    w.keep(result);
     hit = result.isCollision();
     return hit;
   }
@@ -409,12 +407,10 @@ double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
       bound && bound->value > 0.0 && bound->exact)
     return bound->value;
   WarmStart& w = warm(shape, obstacle);
-  request.cached_gjk_guess = w.guess;
-  request.cached_support_func_guess = w.hint;
+  w.start(request);
   result.clear();
   const double d = coal::distance(&object, &obstacle, request, result);
-  w.guess = result.cached_gjk_guess;
-  w.hint = result.cached_support_func_guess;
+  w.keep(result);
   return d > 0.0 ? d : 0.0;  // an overlap, or anything coal cannot tell (NaN): no clearance
 }
 

@@ -142,6 +142,16 @@ class World {
   struct WarmStart {
     coal::Vec3s guess = coal::Vec3s(1.0, 0.0, 0.0);
     coal::support_func_guess_t hint = coal::support_func_guess_t::Zero();
+    /// Start the next query of the pair here (with GJKInitialGuess::CachedGuess).
+    void start(coal::QueryRequest& request) const {
+      request.cached_gjk_guess = guess;
+      request.cached_support_func_guess = hint;
+    }
+    /// Keep where the query ended.
+    void keep(const coal::QueryResult& result) {
+      guess = result.cached_gjk_guess;
+      hint = result.cached_support_func_guess;
+    }
   };
   struct CollideNear;
   struct DistanceNear;
