@@ -17,13 +17,13 @@ from kcplan.viz import (  # viz selects matplotlib's non-interactive backend
     path_poses,
     scenario_axes,
 )
-from kcplan.world.scenario import Scenario
+from kcplan.world.scenario import Scenario, as_scenario
 
 __all__ = ["animate_path"]
 
 
 def animate_path(
-    scenario: Scenario,
+    scenario: Scenario | str | os.PathLike,
     states,
     path: str | os.PathLike,
     frames: int = 60,
@@ -35,7 +35,8 @@ def animate_path(
 
     Parameters
     ----------
-    scenario : Scenario
+    scenario : Scenario or path-like
+        The scene, or the path of its scenario file.
     states : array_like, shape (k, 3 or 7)
         The path's flat poses, interpolated between waypoints as OMPL does.
     path : path-like
@@ -50,6 +51,7 @@ def animate_path(
     int
         The number of frames written.
     """
+    scenario = as_scenario(scenario)
     n = scenario.dimension
     poses = path_poses(states, n, max(frames - 1, 1))
     fig, ax = scenario_axes(scenario)

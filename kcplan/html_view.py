@@ -20,7 +20,7 @@ from kcplan.geometry.pose import pose_frame
 from kcplan.maps.superquadric import unit_normals
 from kcplan.viz import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
-from kcplan.world.scenario import Obstacle, Scenario
+from kcplan.world.scenario import Obstacle, Scenario, as_scenario
 from kcplan.world.support import box_vertices
 
 __all__ = ["cover_figure", "scene_figure", "write_cover_html", "write_scene_html"]
@@ -92,9 +92,13 @@ def _robot(scenario: Scenario, pose, color: str, name: str) -> list[go.Mesh3d]:
     ]
 
 
-def scene_figure(scenario: Scenario, states=None, frames: int = 60) -> go.Figure:
-    """The scene (and the path ``states``, shape ``(k, 3 or 7)``, with the robot moving
-    along it in about ``frames`` steps) as a plotly figure."""
+def scene_figure(
+    scenario: Scenario | str | os.PathLike, states=None, frames: int = 60
+) -> go.Figure:
+    """The scene (a scenario, or the path of its file; and the path ``states``, shape
+    ``(k, 3 or 7)``, with the robot moving along it in about ``frames`` steps) as a
+    plotly figure."""
+    scenario = as_scenario(scenario)
     n = scenario.dimension
     traces = []
     for ob in scenario.obstacles:
@@ -164,7 +168,9 @@ def scene_figure(scenario: Scenario, states=None, frames: int = 60) -> go.Figure
     return figure
 
 
-def write_scene_html(scenario: Scenario, path: str | os.PathLike, states=None) -> None:
+def write_scene_html(
+    scenario: Scenario | str | os.PathLike, path: str | os.PathLike, states=None
+) -> None:
     """Write :func:`scene_figure` as one self-contained HTML file (plotly.js embedded;
     works offline), atomically."""
     html = scene_figure(scenario, states).to_html(include_plotlyjs=True, full_html=True)

@@ -20,7 +20,7 @@ from kcplan.files import atomic_output  # noqa: E402
 from kcplan.geometry.pose import Edge, pose_frame  # noqa: E402
 from kcplan.geometry.robot import Robot  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
-from kcplan.world.scenario import Scenario  # noqa: E402
+from kcplan.world.scenario import Scenario, as_scenario  # noqa: E402
 
 __all__ = [
     "save_figure",
@@ -280,13 +280,15 @@ def scenario_axes(scenario: Scenario):
 
 
 def plot_scenario(
-    scenario: Scenario,
+    scenario: Scenario | str | os.PathLike,
     path: str | os.PathLike,
     poses=(),
     title: str | None = None,
     guards: float | None = None,
 ) -> None:
-    """Draw a scenario (2D top view or 3D perspective) into an image file."""
+    """Draw a scenario (or the scenario file at a path; 2D top view or 3D perspective)
+    into an image file."""
+    scenario = as_scenario(scenario)
     fig, ax = scenario_axes(scenario)
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
@@ -311,10 +313,16 @@ def path_poses(states, n: int, count: int = 40) -> np.ndarray:
 
 
 def plot_path(
-    scenario: Scenario, states, path: str | os.PathLike, guards=None, title: str | None = None
+    scenario: Scenario | str | os.PathLike,
+    states,
+    path: str | os.PathLike,
+    guards=None,
+    title: str | None = None,
 ) -> None:
     """Draw a scenario with a path: its centre line, the robot at intervals along it and,
-    if given, guards as ``(pose, inflation)`` pairs (dashed)."""
+    if given, guards as ``(pose, inflation)`` pairs (dashed); ``scenario`` may be the
+    path of a scenario file."""
+    scenario = as_scenario(scenario)
     n = scenario.dimension
     poses = path_poses(states, n) if len(states) else []
     fig, ax = scenario_axes(scenario)

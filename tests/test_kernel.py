@@ -4,7 +4,8 @@
   on python-fcl) decide the same random edges, in the same order on the same world, the
   same way; every edge either of them accepts is free under gap-free verification
   (:func:`kcplan.planning.verify.verify_path`, python-fcl clearances only).
-* A pose that is not finite is never free, also through OMPL states.
+* A pose that is not finite is never free, also through OMPL states; nor is a pose
+  whose numbers overflow (the fault table), nor one far outside the bounds.
 * Wrong input raises ValueError saying what was expected; fuzzed input never aborts the
   process, and an edge the kernel accepts in a small random world verifies free.
 * The guard cache stays within its bound.
@@ -29,6 +30,7 @@ from kcplan._kernel import World as KernelWorld
 from kcplan.geometry.pose import Edge, quaternion_multiply, wrap_angle
 from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.planning.certifier import CERTIFICATE_SETS, COUNTER_NAMES, EdgeCertifier
+from kcplan.planning.domain import PoseDomain
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import set_state, state_space
@@ -546,6 +548,116 @@ def test_kernel_rejects_poses_that_are_not_finite_and_world_queries_refuse_them(
     assert certifier.counters["rejected"] == certifier.counters["rejected_end_state"]
     assert certifier.counters["rejected"] == expected + extra
     assert certifier.check(good, near)  # nothing sticks
+
+
+MAGNITUDES = (1e10, 1e100, 1e154, 1e200, 1e308, -1e308)
+"""Finite numbers whose squares, products or sums overflow (issue 26, item 1)."""
+
+
+def _closed_room(n: int) -> Scenario:
+    """A robot inside a closed room [0, 24]^n: every edge that leaves it crosses a wall."""
+    walls = []
+    for axis in range(n):
+        for side in (-0.5, 24.5):
+            centre, size = [12.0] * n, [26.0] * n
+            centre[axis], size[axis] = side, 1.0
+            walls.append({"box": {"center": centre, "size": size}})
+    robot = {"semi_axes": [1.0, 0.5] if n == 2 else [1.0, 0.5, 0.4]}
+    data = _scenario_dict("room", n, ([0.0] * n, [24.0] * n), robot, walls)
+    return parse_scenario(data, check=False)
+
+
+@pytest.mark.parametrize("backend", ["kernel", "python"])
+@pytest.mark.parametrize("n", [2, 3])
+def test_no_magnitude_of_any_coordinate_certifies_an_edge_through_a_wall(n, backend):
+    """The fault table: from the middle of a closed room, an edge to a pose with one field
+    at each of MAGNITUDES, in a fresh validator each time, through OMPL states. A
+    translation that leaves the room crosses a wall, so it must be rejected (both ways,
+    and the state is invalid); a rotation field may be decided either way (the robot
+    turns in place, 11 from every wall with a reach of 1), but never raises or stores an
+    error."""
+    scenario = _closed_room(n)
+    fields = _fields(n)
+    decided = {}
+    for value in MAGNITUDES:
+        for field in fields:
+            world = CollisionWorld(scenario)
+            si = ob.SpaceInformation(state_space(*scenario.bounds))
+            mv = KCMotionValidator(si, world.robot, world, backend=backend)
+            try:
+                start, bad = si.allocState(), si.allocState()
+                middle = np.array([12.0] * n + ([0.3] if n == 2 else [0.0, 0.0, 0.0, 1.0]))
+                set_state(start, middle, n)
+                set_state(bad, middle, n)
+                _set_field(bad, n, field, value)
+                forward, backward = mv.checkMotion(start, bad), mv.checkMotion(bad, start)
+                valid = mv.state_valid(bad)
+                assert mv.error is None, (field, value, mv.error)
+                if field in ("x", "y", "z"):
+                    assert (forward, backward, valid) == (False, False, False), (field, value)
+                decided[field, value] = forward
+            finally:
+                mv.close()
+    assert len(decided) == len(fields) * len(MAGNITUDES)
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_the_pose_domain_twins_admit_the_same_poses(n):
+    """kcplan/_kernel/domain.hpp and kcplan/planning/domain.py: the same box (bounds padded
+    by their diagonal and the robot's reach), yaw range and quaternion norms, on poses
+    just inside and just outside each limit, through the certifiers' state checks."""
+    scenario = _closed_room(n)
+    world = CollisionWorld(scenario)
+    kernel, python = KernelCertifier(world), EdgeCertifier(world)
+    pad = math.hypot(*([24.0] * n)) + world.robot.reach
+    assert python.domain.high[0] == pytest.approx(24.0 + pad)
+    middle = [12.0] * n + ([0.3] if n == 2 else [0.0, 0.0, 0.0, 1.0])
+    cases = []
+    for k in range(n):
+        for edge, inside in ((-pad, True), (-pad - 1e-6, False), (24 + pad, True),
+                             (24 + pad + 1e-6, False)):  # fmt: skip
+            p = list(middle)
+            p[k] = edge
+            cases.append((p, inside))
+    if n == 2:
+        cases += [(middle[:2] + [2 * math.pi], True), (middle[:2] + [6.3], False)]
+    else:
+        for scale, inside in ((1e-99, True), (1e-101, False), (1e99, True), (1e101, False)):
+            cases.append((middle[:3] + [0.0, 0.0, 0.0, scale], inside))
+    for pose, inside in cases:
+        assert python.domain.admits(pose) is inside, pose
+        if not inside:  # outside: never free, and no query is spent on it
+            before = world.kernel.counters["collision_queries"]
+            assert kernel.state_valid(pose) is False and python.state_valid(pose) is False
+            assert world.kernel.counters["collision_queries"] == before
+    with pytest.raises(ValueError, match="bounds"):
+        PoseDomain(n, [0.0] * n, [1e100] * n)
+    with pytest.raises(ValueError, match="bounds"):
+        PoseDomain(n, [1.0] * n, [0.0] * n)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_fuzzed_edges_with_huge_numbers_are_never_certified_outside_the_domain(data):
+    """Edges from inside the closed room to poses with any fields drawn from every float
+    magnitude: both backends decide them alike, never raise, and accept only edges whose
+    end stays in the room (so the walls' check without gaps can verify them)."""
+    n = data.draw(st.sampled_from([2, 3]))
+    scenario = _closed_room(n)
+    world = CollisionWorld(scenario)
+    kernel, python = KernelCertifier(world), EdgeCertifier(world)
+    huge = st.floats(allow_nan=False, allow_infinity=False) | st.sampled_from(MAGNITUDES)
+    middle = [12.0] * n + ([0.3] if n == 2 else [0.0, 0.0, 0.0, 1.0])
+    for _ in range(5):
+        p2 = list(middle)
+        for k in data.draw(st.sets(st.integers(0, len(middle) - 1), min_size=1)):
+            p2[k] = data.draw(huge)
+        decisions = kernel.check(middle, p2), python.check(middle, p2)
+        if not python.domain.admits(p2):
+            assert decisions == (False, False), p2
+        if any(decisions):
+            assert all(1.0 < x < 23.0 for x in p2[:n]), p2
+            assert not verify_path(world, [middle, p2]).collides, p2
 
 
 # ------------------------------------------------------------------ 3. errors

@@ -9,6 +9,7 @@ EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
                              std::unique_ptr<KCPolytope> polytope)
     : world_(world), robot_(world.robot()), discrete_(options.discrete),
       max_guards_(options.max_guards), core_radius_(world.robot().core_radius()),
+      domain_(world.robot().dimension(), options.low, options.high, world.robot().reach()),
       cache_(options.cache_entries) {
   if (options.certificates.empty())
     throw std::invalid_argument("certificates: expected names from ball, rotation, polytope, region");
@@ -51,7 +52,7 @@ Guard EdgeCertifier::measure(const Pose& pose) {
 }
 
 bool EdgeCertifier::state_valid(const Pose& pose) {
-  if (!pose.finite) return false;
+  if (!domain_.admits(pose)) return false;
   const GuardCache::Key key = GuardCache::key(pose);
   const int known = cache_.validity(key);
   if (known >= 0) return known == 1;
@@ -108,10 +109,10 @@ bool EdgeCertifier::reject(std::int64_t& reason) {
 bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
   CertifierCounters& c = counters;
   ++c.edges;
-  if (!p1.finite || !p2.finite) return reject(c.rejected_end_state);  // never free
   if (p1.size != p2.size || p1.size != pose_size(robot_.dimension()))
     throw std::invalid_argument("pose: expected " + std::to_string(pose_size(robot_.dimension())) +
                                 " numbers per pose");
+  if (!domain_.admits(p1) || !domain_.admits(p2)) return reject(c.rejected_end_state);
   const GuardCache::Key k1 = GuardCache::key(p1), k2 = GuardCache::key(p2);
   CoreOccupancy* grid = grid_ ? &*grid_ : nullptr;
   if (grid && grid->blocked(p2.t)) return reject(c.rejected_occupancy);

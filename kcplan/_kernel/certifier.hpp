@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "certificates.hpp"
+#include "domain.hpp"
 #include "guard.hpp"
 #include "occupancy.hpp"
 #include "pose.hpp"
@@ -35,7 +36,9 @@ struct CertifierOptions {
   double horizon = -1.0;     ///< region horizon; < 0: the largest semi-axis
   bool sweep_test = true;    ///< the core-capsule rejection (needs a core)
   bool occupancy = true;     ///< the occupancy grid (needs a core)
-  std::array<double, 3> low{0, 0, 0}, high{0, 0, 0};  ///< bounds of the robot's origin
+  /// Bounds of the robot's origin: the occupancy grid's box, and the domain of poses
+  /// decided (PoseDomain pads them by their diagonal and the robot's reach).
+  std::array<double, 3> low{0, 0, 0}, high{0, 0, 0};
   std::size_t cache_entries = 200000;
 };
 
@@ -48,8 +51,9 @@ struct CertifierOptions {
 /// through a blocked cell or a colliding core capsule rejects it; (4) missing endpoint
 /// guards are measured and cached; (5) advancement places guards in the middle of what is
 /// left open until nothing is (certified), one touches an obstacle or makes no progress
-/// (rejected), or max_guards were placed ("not proven": rejected). A pose that is not
-/// finite is never free. Not thread-safe (the world's coal objects are reused).
+/// (rejected), or max_guards were placed ("not proven": rejected). A pose outside the
+/// domain (not finite, far outside the bounds, see PoseDomain) is never free and costs no
+/// query. Not thread-safe (the world's coal objects are reused).
 class EdgeCertifier {
  public:
   EdgeCertifier(World& world, const CertifierOptions& options,
@@ -68,6 +72,7 @@ class EdgeCertifier {
   const std::vector<std::unique_ptr<Certificate>>& certificates() const { return certificates_; }
   const std::vector<double>& covered() const { return covered_; }
   const GuardCache& cache() const { return cache_; }
+  const PoseDomain& domain() const { return domain_; }
   double horizon() const { return horizon_; }
   double margin() const { return margin_; }
   bool sweep_test() const { return sweep_test_; }
@@ -92,6 +97,7 @@ class EdgeCertifier {
   bool use_region_ = false, discrete_ = false, sweep_test_ = false;
   int max_guards_;
   double horizon_, margin_, core_radius_;
+  PoseDomain domain_;
   GuardCache cache_;
   std::optional<CoreOccupancy> grid_;
   std::vector<FreeRegion> regions_;  // scratch of region queries

@@ -66,7 +66,9 @@ class CoreOccupancy {
     if (!enabled_) return false;
     double length = 0.0, d[3];
     for (int k = 0; k < n_; ++k) d[k] = b[k] - a[k], length += d[k] * d[k];
-    const int steps = std::min(static_cast<int>(std::sqrt(length) / side_) + 1, 256);
+    // clamped before the cast: casting a length that overflowed (inf, NaN) is undefined
+    const double cells = std::sqrt(length) / side_;
+    const int steps = (cells < 255.0 ? static_cast<int>(cells) : 255) + 1;
     for (int j = steps; j >= 0; --j) {
       const double f = double(j) / steps;
       double p[3];

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kcplan.geometry.pose import Edge
+from kcplan.geometry.pose import Edge, pose_size
 from kcplan.geometry.robot import Robot
 from kcplan.planning.certificates import (
     CERTIFICATE_NAMES,
@@ -21,6 +21,7 @@ from kcplan.planning.certificates import (
     FreeRegionPlanes,
     KCPolytope,
 )
+from kcplan.planning.domain import PoseDomain
 from kcplan.planning.guard import Guard, GuardCache
 from kcplan.planning.ladder import GuardLadder
 from kcplan.world.occupancy import CoreOccupancy
@@ -125,6 +126,10 @@ class EdgeCertifier:
     cache : GuardCache, optional
         Shared with the state validity checker (see :meth:`state_valid`).
 
+    Poses outside :attr:`domain` (:class:`kcplan.planning.domain.PoseDomain`: not
+    finite, or outside the scenario's bounds by more than the scene's size) are never
+    free and cost no query.
+
     Not thread-safe (the world reuses one FCL robot object). Its compiled twin, with the
     same steps and counters, is :class:`kcplan.planning.kernel.KernelCertifier`.
     """
@@ -163,6 +168,8 @@ class EdgeCertifier:
         self.world = world
         self.robot, self.n = robot, robot.dimension
         self.core_radius = robot.core_radius
+        bounds = world.scenario.bounds if hasattr(world, "scenario") else (None, None)
+        self.domain = PoseDomain(robot.dimension, *bounds, reach=robot.reach)
         self.certificates = []
         for name in certificates:
             if name in ("ball", "rotation"):
@@ -211,8 +218,8 @@ class EdgeCertifier:
         remembered so that a later edge ending there skips its end-state query.
         ``key`` is ``pose.tobytes()`` when the caller has it."""
         p = np.asarray(pose, dtype=float)
-        if not _is_pose(p, self.n):
-            return False  # a pose that is not finite is never free
+        if not self.domain.admits(p):
+            return False  # never free (not finite, or far outside the bounds)
         key = p.tobytes() if key is None else key
         known = self.cache.validity(key)
         if known is not None:
@@ -279,12 +286,15 @@ class EdgeCertifier:
 
     def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs); an
-        edge with a pose that is not finite is rejected (``rejected_end_state``)."""
+        edge with a pose outside :attr:`domain` (not finite, far outside the bounds; see
+        :class:`kcplan.planning.domain.PoseDomain`) is rejected (``rejected_end_state``)."""
         c = self.counters
         c["edges"] += 1
         p1 = np.asarray(pose1, dtype=float)
         p2 = np.asarray(pose2, dtype=float)
-        if not (_is_pose(p1, self.n) and _is_pose(p2, self.n)):
+        if p1.shape != p2.shape or p1.size != pose_size(self.n):
+            raise ValueError(f"pose: expected {pose_size(self.n)} numbers per pose")
+        if not (self.domain.admits(p1) and self.domain.admits(p2)):
             return self._reject("rejected_end_state")  # never free
         k1, k2 = p1.tobytes(), p2.tobytes()
         cache, grid = self.cache, self._occupancy()
@@ -371,11 +381,6 @@ class EdgeCertifier:
             if self.world.in_collision(edge.pose(s)):
                 return self._reject("rejected_guard")
         return True
-
-
-def _is_pose(p: np.ndarray, n: int) -> bool:
-    """Finite numbers and, in 3D, a quaternion that can be normalised."""
-    return bool(np.isfinite(p).all()) and (n == 2 or float(p[3:] @ p[3:]) > 0.0)
 
 
 def check_certificates(

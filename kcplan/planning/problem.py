@@ -8,6 +8,7 @@ differences are the planner and, for the ``kc-*`` planners, the motion validator
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field, replace
 
@@ -22,7 +23,7 @@ from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
 from kcplan.world.collision import CollisionWorld
-from kcplan.world.scenario import Scenario
+from kcplan.world.scenario import Scenario, as_scenario
 
 __all__ = ["PLANNERS", "PlannerSpec", "PlanResult", "plan", "seed_ompl"]
 
@@ -244,7 +245,7 @@ class PlanResult:
 
 
 def plan(
-    scenario: Scenario,
+    scenario: Scenario | str | os.PathLike,
     planner: str = "kc-rrtconnect",
     time_limit: float = 10.0,
     seed: int | None = None,
@@ -257,7 +258,8 @@ def plan(
 
     Parameters
     ----------
-    scenario : Scenario
+    scenario : Scenario or path-like
+        A scenario, or the path of a scenario file (:func:`kcplan.world.scenario.as_scenario`).
     planner : str
         A key of :data:`PLANNERS`.
     time_limit : float
@@ -289,6 +291,7 @@ def plan(
         check_planner_name(planner)
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
+    scenario = as_scenario(scenario)
     spec = PLANNERS[planner]
     if seed is not None:
         seed_ompl(seed)

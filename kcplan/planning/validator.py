@@ -6,7 +6,11 @@ Usable in any OMPL setup on SE(2) or SE(3)::
     mv = KCMotionValidator(si, robot, world)    # robot: Robot or semi-axes
     si.setMotionValidator(mv)
     ...
-    mv.close()          # when done: breaks the si <-> validator reference cycle
+
+The validator keeps no reference to ``si`` (only to its state space): ``si`` holds the
+validator through a C++ ``shared_ptr`` that Python's collector cannot see, so a reference
+back would make a cycle that outlives the script, and nanobind would report its objects
+as leaked at exit (ompl-python-notes, section 6).
 
 Contract (OMPL's, as far as the Python binding allows):
 
@@ -95,8 +99,7 @@ class KCMotionValidator(ob.MotionValidator):
         backend: str | None = None,
     ):
         super().__init__(si)
-        self.si = si
-        self.space = si.getStateSpace()
+        self.space = si.getStateSpace()  # not si itself: see the module docstring
         robot = Robot.of(robot)
         ladder = None
         if certificates is not None and "polytope" in certificates:
@@ -182,8 +185,8 @@ class KCMotionValidator(ob.MotionValidator):
             resolution = 0.01
             if self.certifier.fallback == "discrete":
                 length = self.space.distance(s1, s2)
-                extent = self.space.getMaximumExtent()
-                step = self.si.getStateValidityCheckingResolution() * extent
+                # si's validity-checking resolution times the space's extent
+                step = self.space.getLongestValidSegmentLength()
                 resolution = min(1.0, step / length) if length > 0 else 1.0
             return bool(
                 self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
@@ -200,5 +203,7 @@ class KCMotionValidator(ob.MotionValidator):
             raise self.error
 
     def close(self) -> None:
-        """Drop references to OMPL objects (call when done; see ompl-python-notes 6)."""
+        """Drop every reference the validator holds (optional: it makes no reference
+        cycle with ``si``); ``checkMotion`` rejects every edge afterwards."""
         self.__dict__.clear()
+        self.error = RuntimeError("KCMotionValidator: used after close()")

@@ -28,6 +28,7 @@ would be missed.
 from __future__ import annotations
 
 import math
+import os
 
 import fcl
 import numpy as np
@@ -37,7 +38,7 @@ from kcplan._kernel import _core, build_kernel_world
 from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
-from kcplan.world.scenario import Obstacle, Scenario
+from kcplan.world.scenario import Obstacle, Scenario, as_scenario
 from kcplan.world.support import box_vertices, piece_supports
 
 __all__ = ["CLEARANCE_RTOL", "CLEARANCE_ATOL", "CollisionWorld", "polygon_prism"]
@@ -91,8 +92,8 @@ class CollisionWorld:
 
     Parameters
     ----------
-    scenario : Scenario
-        The obstacles and the robot.
+    scenario : Scenario or path-like
+        The obstacles and the robot, or the path of their scenario file.
     robot : Robot or array_like, optional
         Query a different robot (semi-axes ``(n,)`` for one body at the origin, e.g. a
         guard ``(1 + eps) a``); default the scenario's robot.
@@ -111,7 +112,10 @@ class CollisionWorld:
     per body. Not thread-safe: the robot's FCL objects are reused between queries.
     """
 
-    def __init__(self, scenario: Scenario, robot: Robot | ArrayLike | None = None):
+    def __init__(
+        self, scenario: Scenario | str | os.PathLike, robot: Robot | ArrayLike | None = None
+    ):
+        scenario = as_scenario(scenario)
         n = scenario.dimension
         if robot is None:
             robot = scenario.robot

@@ -64,10 +64,10 @@ class CoreOccupancy:
     def _cell(self, position: ArrayLike) -> tuple | None:
         index = []
         for k in range(self.dimension):
-            i = int((float(position[k]) - self.low[k]) // self.side)
-            if i < 0 or i >= self.shape[k]:
+            f = (float(position[k]) - self.low[k]) // self.side
+            if not 0.0 <= f < self.shape[k]:  # before int(): inf and NaN have no index
                 return None
-            index.append(i)
+            index.append(int(f))
         return tuple(index)
 
     def blocked(self, position: ArrayLike) -> bool:
@@ -104,7 +104,8 @@ class CoreOccupancy:
         a = [float(v) for v in start[:n]]
         b = [float(v) for v in end[:n]]
         d = [y - x for x, y in zip(a, b, strict=True)]
-        steps = min(int(math.dist(a, b) / self.side) + 1, 256)
+        cells = math.dist(a, b) / self.side
+        steps = (int(cells) if cells < 255.0 else 255) + 1  # inf and NaN: 256
         cells, low, side, shape = self._cells, self.low, self.side, self.shape
         # one point per cell length, from the end backwards: a new state in an obstacle,
         # the common case, is found first; plain floats beat numpy on a few points
@@ -112,10 +113,10 @@ class CoreOccupancy:
             f = j / steps
             cell = []
             for k in range(n):
-                i = int((a[k] + f * d[k] - low[k]) // side)
-                if i < 0 or i >= shape[k]:
+                i = (a[k] + f * d[k] - low[k]) // side
+                if not 0.0 <= i < shape[k]:
                     break
-                cell.append(i)
+                cell.append(int(i))
             else:
                 if cells.get(tuple(cell)) == _BLOCKED:
                     return True

@@ -42,6 +42,7 @@ __all__ = [
     "Obstacle",
     "Scenario",
     "ScenarioError",
+    "as_scenario",
     "load_scenario",
     "parse_scenario",
     "scenario_to_dict",
@@ -554,6 +555,28 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
     except (yaml.YAMLError, RecursionError) as err:
         raise ScenarioError(f"{source}: YAML syntax error: {type(err).__name__}") from None
     return parse_scenario(data, source, p.resolve().parent)
+
+
+def as_scenario(value: Scenario | str | os.PathLike) -> Scenario:
+    """The scenario a public entry point was given: ``value`` itself when it is a
+    :class:`Scenario`, the file it names when it is a path (``str`` or ``os.PathLike``,
+    read by :func:`load_scenario`).
+
+    Raises
+    ------
+    TypeError
+        For anything else, saying what is expected.
+    ScenarioError
+        For a path whose file is not a valid scenario.
+    """
+    if isinstance(value, Scenario):
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        return load_scenario(value)
+    raise TypeError(
+        "scenario: expected a kcplan Scenario or the path of a scenario file (str or "
+        f"os.PathLike), got {type(value).__name__}"
+    )
 
 
 def scenario_to_dict(scenario: Scenario) -> dict:
