@@ -350,6 +350,36 @@ def test_an_own_setup_without_close_leaks_nothing_at_exit(path, backend, fallbac
     assert not leaks, leaks
 
 
+PLAN_WITH_PROGRESS = """
+import sys
+from kcplan import plan
+for planner in sys.argv[2:]:
+    result = plan(sys.argv[1], planner, time_limit=0.3, seed=3, progress=0.1, simplify=False)
+    print(planner, result.solved, len(result.progress.get("time REAL", [])))
+"""
+
+
+def test_plan_with_progress_leaks_nothing_at_exit():
+    """AORRTC keeps its termination condition, whose callable holds the progress
+    recorder; a recorder that kept the planner after solve() left planner, validator
+    and space information alive at exit (nanobind listed them, CI's last lines)."""
+    planners = ["kc-aorrtc", "kc-rrtstar", "kc-bitstar", "aorrtc"]
+    proc = subprocess.run(
+        [sys.executable, "-c", PLAN_WITH_PROGRESS, str(ROOT / "scenarios/2d/open_field.yaml"),
+         *planners],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.split("\n")
+    for planner, line in zip(planners, lines, strict=False):
+        name, solved, samples = line.split()
+        assert (name, solved) == (planner, "True") and int(samples) >= 2, line
+    assert not [line for line in proc.stderr.splitlines() if "leaked" in line], proc.stderr
+
+
 def test_public_entry_points_take_a_scenario_or_its_path():
     """``plan``, ``CollisionWorld`` and the views accept a path (str or os.PathLike) as
     well as a Scenario, and say what is expected for anything else."""

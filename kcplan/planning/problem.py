@@ -345,9 +345,11 @@ def plan(
     else:
         stop = ob.timedPlannerTerminationCondition(float(time_limit))
     try:
-        ss.solve(stop)
-        if recorder is not None:
-            recorder.finish()
+        try:
+            ss.solve(stop)
+        finally:
+            if recorder is not None:
+                recorder.finish()
         if validator is not None:
             validator.raise_error()
         solve_time = float(ss.getLastPlanComputationTime())

@@ -102,13 +102,19 @@ class ProgressRecorder:
         self.samples.append([now - self._t0, *(get(self.planner) for _, get in self.properties)])
 
     def finish(self) -> None:
-        """Take the last sample, at the end of ``solve()``."""
+        """Take the last sample, at the end of ``solve()``, and let go of the planner.
+
+        Some planners (AORRTC) keep the termination condition, whose Python callable
+        holds this recorder: holding the planner after ``solve()`` would make a cycle
+        through C++ that Python's collector cannot see, so nothing of it would be freed.
+        """
         now = time.perf_counter()
         if not self.samples or now - self._t0 > self.samples[-1][0]:
             self._sample(now)
         # a solution found in the very last iteration was never seen by the condition
         if self.first_solution_time is None and math.isfinite(self.samples[-1][1]):
             self.first_solution_time = self.samples[-1][0]
+        self.planner = None
 
     def to_json(self) -> dict[str, list[float]]:
         """The samples as columns, ``{property name: values}`` (``inf`` stays ``inf``)."""
