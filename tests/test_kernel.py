@@ -29,7 +29,12 @@ from kcplan._kernel import Robot as KernelRobot
 from kcplan._kernel import World as KernelWorld
 from kcplan.geometry.pose import Edge, quaternion_multiply, wrap_angle
 from kcplan.maps.superquadric import bounding_polytopes
-from kcplan.planning.certifier import CERTIFICATE_SETS, COUNTER_NAMES, EdgeCertifier
+from kcplan.planning.certifier import (
+    CERTIFICATE_SETS,
+    COUNTER_NAMES,
+    EdgeCertifier,
+    probe_points,
+)
 from kcplan.planning.domain import PoseDomain
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
@@ -660,6 +665,50 @@ def test_fuzzed_edges_with_huge_numbers_are_never_certified_outside_the_domain(d
             assert not verify_path(world, [middle, p2]).collides, p2
 
 
+def _turn_past_a_pin(backend: str, probes: int):
+    """A 4 x 0.6 ellipse at (5, 5) turning from yaw -pi/4 to pi/4 past a pin at (6.9, 5):
+    both ends are free and the core (radius 0.3) does not move, but at yaw 0 the tip
+    (7, 5) is inside the pin."""
+    data = _scenario_dict(
+        "pin", 2, ([0.0, 0.0], [10.0, 10.0]), {"semi_axes": [2.0, 0.3]},
+        [{"circle": {"center": [6.9, 5.0], "radius": 0.15}}],
+    )  # fmt: skip
+    world = CollisionWorld(parse_scenario(data, check=False))
+    cls = KernelCertifier if backend == "kernel" else EdgeCertifier
+    return world, cls(world, probes=probes)
+
+
+@pytest.mark.parametrize("backend", ["kernel", "python"])
+def test_a_colliding_probe_rejects_before_any_guard(backend):
+    """Step 3's probes: the edge's middle collides, so the first probe (s = 1/2) rejects
+    it with one collision query and no guard; without probes the same edge costs guards
+    before it is rejected, and both decisions agree with the gap-free check."""
+    p1, p2 = [5.0, 5.0, -math.pi / 4], [5.0, 5.0, math.pi / 4]
+    world, certifier = _turn_past_a_pin(backend, probes=3)
+    assert verify_path(world, [p1, p2]).collides
+    assert certifier.state_valid(p1) and certifier.state_valid(p2)
+    before = world.counters["collision_queries"]
+    assert not certifier.check(p1, p2)
+    c = certifier.counters
+    assert (c["rejected_probe"], c["probes"], c["guards"]) == (1, 1, 0)
+    assert world.counters["collision_queries"] == before + 2  # the core sweep, one probe
+    world, certifier = _turn_past_a_pin(backend, probes=0)
+    assert not certifier.check(p1, p2)
+    c = certifier.counters
+    assert c["rejected_probe"] == c["probes"] == 0 and c["guards"] >= 2
+    assert c["rejected_guard"] + c["not_proven"] == 1
+    with pytest.raises(ValueError, match="probes"):
+        _turn_past_a_pin(backend, probes=-1)
+
+
+def test_probe_points_halve_the_largest_stretch_left():
+    assert probe_points(7) == [0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875]
+    for count in range(1, 64):
+        points = sorted([0.0, *probe_points(count), 1.0])
+        gaps = np.diff(points)
+        assert len(set(points)) == count + 2 and gaps.max() <= 2 * gaps.min() + 1e-15
+
+
 # ------------------------------------------------------------------ 3. errors
 
 
@@ -765,7 +814,7 @@ def test_degenerate_obstacles_and_world_options_are_refused():
 
 def _compiled(world, certificates=("region",), max_guards=64, cache=100, ladder=([], [], 1.0)):
     return CompiledCertifier(
-        world, list(certificates), False, max_guards, -1.0, True, True,
+        world, list(certificates), False, max_guards, -1.0, True, True, 3,
         [-10.0] * 3, [10.0] * 3, cache, *ladder,
     )  # fmt: skip
 
@@ -800,7 +849,7 @@ def test_unknown_or_unfit_certificates_are_refused():
     with pytest.raises(TypeError):
         _compiled(kernel_world, cache=-1)
     discrete = CompiledCertifier(
-        kernel_world, ["ball"], True, 64, -1.0, False, False, [-10.0] * 3, [10.0] * 3, 100,
+        kernel_world, ["ball"], True, 64, -1.0, False, False, 0, [-10.0] * 3, [10.0] * 3, 100,
         [], [], 1.0,
     )  # fmt: skip
     with pytest.raises(ValueError, match="resolution: expected a positive number"):

@@ -105,7 +105,9 @@ def test_accepted_edges_are_free_and_colliding_edges_rejected(
 def test_counters_add_up():
     s = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
     world = CollisionWorld(s)
-    certifier = EdgeCertifier(world, certificates=("ball",), sweep_test=False, occupancy=False)
+    certifier = EdgeCertifier(
+        world, certificates=("ball",), sweep_test=False, occupancy=False, probes=0
+    )
     assert certifier.check(s.start, s.start + np.array([3.0, 0.0, 0.1]))
     c = certifier.counters
     # end-state query, then one endpoint guard at the start covers the whole edge

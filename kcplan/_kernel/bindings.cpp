@@ -52,11 +52,12 @@ nb::dict certifier_counters(const kcplan::CertifierCounters& c) {
   nb::dict d;
 #define KC_COUNTER(name) d[#name] = c.name
   KC_COUNTER(edges); KC_COUNTER(rejected); KC_COUNTER(rejected_end_state);
-  KC_COUNTER(rejected_sweep); KC_COUNTER(rejected_occupancy); KC_COUNTER(rejected_guard);
+  KC_COUNTER(rejected_sweep); KC_COUNTER(rejected_occupancy); KC_COUNTER(rejected_probe);
+  KC_COUNTER(rejected_guard);
   KC_COUNTER(not_proven); KC_COUNTER(certified_by_endpoints); KC_COUNTER(certified_one_guard);
   KC_COUNTER(guards); KC_COUNTER(endpoint_guards); KC_COUNTER(cached_guards);
   KC_COUNTER(bisection_nodes); KC_COUNTER(collision_queries); KC_COUNTER(occupancy_rejections);
-  KC_COUNTER(occupancy_queries);
+  KC_COUNTER(occupancy_queries); KC_COUNTER(probes);
 #undef KC_COUNTER
   return d;
 }
@@ -161,13 +162,14 @@ NB_MODULE(_core, m) {
           "__init__",
           [](kcplan::EdgeCertifier* self, kcplan::World& world,
              const std::vector<std::string>& certificates, bool discrete, int max_guards,
-             double horizon, bool sweep_test, bool occupancy, std::array<double, 3> low,
+             double horizon, bool sweep_test, bool occupancy, int probes, std::array<double, 3> low,
              std::array<double, 3> high, std::size_t cache_entries,
              const std::vector<double>& levels, const std::vector<std::vector<double>>& rows,
              double scale) {
             kcplan::CertifierOptions o;
             o.certificates = certificates, o.discrete = discrete, o.max_guards = max_guards;
             o.horizon = horizon, o.sweep_test = sweep_test, o.occupancy = occupancy;
+            o.probes = probes;
             o.low = low, o.high = high, o.cache_entries = cache_entries;
             std::unique_ptr<kcplan::KCPolytope> polytope;
             if (!levels.empty())
@@ -176,7 +178,7 @@ NB_MODULE(_core, m) {
             new (self) kcplan::EdgeCertifier(world, o, std::move(polytope));
           },
           "world"_a, "certificates"_a, "discrete"_a, "max_guards"_a, "horizon"_a,
-          "sweep_test"_a, "occupancy"_a, "low"_a, "high"_a, "cache_entries"_a,
+          "sweep_test"_a, "occupancy"_a, "probes"_a, "low"_a, "high"_a, "cache_entries"_a,
           "ladder_levels"_a, "ladder_rows"_a, "ladder_scale"_a, nb::keep_alive<1, 2>())
       .def("check",
            [](kcplan::EdgeCertifier& c, const std::vector<double>& p1,
@@ -235,5 +237,6 @@ NB_MODULE(_core, m) {
       .def_prop_ro("margin", &kcplan::EdgeCertifier::margin)
       .def_prop_ro("sweep_test", &kcplan::EdgeCertifier::sweep_test)
       .def_prop_ro("occupancy", &kcplan::EdgeCertifier::occupancy)
+      .def_prop_ro("probes", &kcplan::EdgeCertifier::probes)
       .def_prop_ro("discrete", &kcplan::EdgeCertifier::discrete);
 }

@@ -8,7 +8,7 @@ namespace kcplan {
 EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
                              std::unique_ptr<KCPolytope> polytope)
     : world_(world), robot_(world.robot()), discrete_(options.discrete),
-      max_guards_(options.max_guards), core_radius_(world.robot().core_radius()),
+      max_guards_(options.max_guards), probes_(options.probes), core_radius_(world.robot().core_radius()),
       domain_(world.robot().dimension(), options.low, options.high, world.robot().reach()),
       cache_(options.cache_entries) {
   if (options.certificates.empty())
@@ -32,6 +32,7 @@ EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
     }
   }
   if (max_guards_ < 0) throw std::invalid_argument("max_guards: expected a number >= 0");
+  if (probes_ < 0) throw std::invalid_argument("probes: expected a number >= 0");
   covered_.assign(certificates_.size(), 0.0);
   horizon_ = options.horizon < 0.0 ? robot_.largest_semi_axis() : options.horizon;
   margin_ = world.atol() + 1e-12 * robot_.reach();
@@ -144,6 +145,7 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
     if (world_.sweep_core_collides(edge.pose(lo).t, edge.pose(hi).t, core_radius_))
       return reject(c.rejected_sweep);
   }
+  if (!probe(edge, lo, hi)) return reject(c.rejected_probe);
   if (!g1) {
     g1 = endpoint(p1, k1);
     if (g1->clearance <= 0.0) return reject(c.rejected_guard);
@@ -160,6 +162,20 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
   }
   if (discrete_) return sample(edge, resolution, lo, hi);
   return advance(edge, lo, hi);
+}
+
+bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {
+  // the van der Corput points 1/2, 1/4, 3/4, 1/8, 5/8, 3/8, ...: each probe halves the
+  // largest stretch left unprobed, as bisection would
+  for (int i = 1; i <= probes_; ++i) {
+    double u = 0.0, bit = 0.5;
+    for (int k = i; k > 0; k >>= 1, bit *= 0.5)
+      if (k & 1) u += bit;
+    ++counters.probes;
+    ++counters.collision_queries;
+    if (world_.in_collision(edge.pose(lo + u * (hi - lo)))) return false;
+  }
+  return true;
 }
 
 bool EdgeCertifier::advance(const Edge& edge, double lo, double hi) {

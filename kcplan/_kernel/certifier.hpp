@@ -22,10 +22,11 @@ namespace kcplan {
 /// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
 struct CertifierCounters {
   std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
-               rejected_occupancy = 0, rejected_guard = 0, not_proven = 0,
+               rejected_occupancy = 0, rejected_probe = 0, rejected_guard = 0, not_proven = 0,
                certified_by_endpoints = 0, certified_one_guard = 0, guards = 0,
                endpoint_guards = 0, cached_guards = 0, bisection_nodes = 0,
-               collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0;
+               collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0,
+               probes = 0;
 };
 
 /// Options of an EdgeCertifier; the defaults are the Python certifier's.
@@ -36,6 +37,7 @@ struct CertifierOptions {
   double horizon = -1.0;     ///< region horizon; < 0: the largest semi-axis
   bool sweep_test = true;    ///< the core-capsule rejection (needs a core)
   bool occupancy = true;     ///< the occupancy grid (needs a core)
+  int probes = 3;            ///< collision queries at bisection points before any guard
   /// Bounds of the robot's origin: the occupancy grid's box, and the domain of poses
   /// decided (PoseDomain pads them by their diagonal and the robot's reach).
   std::array<double, 3> low{0, 0, 0}, high{0, 0, 0};
@@ -48,7 +50,10 @@ struct CertifierOptions {
 /// not. It returns true only when the whole edge, interpolated as OMPL does, is proven
 /// free: (1) p2 is rejected by the occupancy grid or one collision query unless the cache
 /// knows it; (2) cached endpoint guards may certify it with no query; (3) a centre path
-/// through a blocked cell or a colliding core capsule rejects it; (4) missing endpoint
+/// through a blocked cell or a colliding core capsule rejects it, and so does a colliding
+/// probe, one of `probes` collision queries at the bisection points 1/2, 1/4, 3/4, 1/8, ...
+/// of what is left open (a colliding pose proves the edge not free at a collision query's
+/// price, before any guard is paid for); (4) missing endpoint
 /// guards are measured and cached; (5) advancement places guards in the middle of what is
 /// left open until nothing is (certified), one touches an obstacle or makes no progress
 /// (rejected), or max_guards were placed ("not proven": rejected). A pose outside the
@@ -77,6 +82,7 @@ class EdgeCertifier {
   double margin() const { return margin_; }
   bool sweep_test() const { return sweep_test_; }
   bool occupancy() const { return grid_.has_value(); }
+  int probes() const { return probes_; }
   bool discrete() const { return discrete_; }
   World& world() { return world_; }
   CertifierCounters counters;
@@ -87,6 +93,7 @@ class EdgeCertifier {
   void reach(const Guard& guard, const Edge& edge, double m, double s0, double s1, double& lo,
              double& hi);
   bool reject(std::int64_t& reason);
+  bool probe(const Edge& edge, double lo, double hi);
   bool advance(const Edge& edge, double lo, double hi);
   bool sample(const Edge& edge, double resolution, double lo, double hi);
 
@@ -95,7 +102,7 @@ class EdgeCertifier {
   std::vector<std::unique_ptr<Certificate>> certificates_;
   std::vector<double> covered_;
   bool use_region_ = false, discrete_ = false, sweep_test_ = false;
-  int max_guards_;
+  int max_guards_, probes_;
   double horizon_, margin_, core_radius_;
   PoseDomain domain_;
   GuardCache cache_;

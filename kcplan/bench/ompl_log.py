@@ -95,6 +95,8 @@ RUN_PROPERTIES: tuple[tuple[str, str, Callable[[dict], object]], ...] = (
     ("kc not proven", "INTEGER", _counter("kc_not_proven")),
     ("kc rejected sweep", "INTEGER", _counter("kc_rejected_sweep")),
     ("kc rejected occupancy", "INTEGER", _counter("kc_rejected_occupancy")),
+    ("kc rejected probe", "INTEGER", _counter("kc_rejected_probe")),
+    ("kc probes", "INTEGER", _counter("kc_probes")),
     ("kc covered region", "REAL", _counter("kc_covered_region")),
     ("kc covered polytope", "REAL", _counter("kc_covered_polytope")),
     ("kc covered ball", "REAL", _counter("kc_covered_ball")),

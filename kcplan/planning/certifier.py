@@ -26,7 +26,14 @@ from kcplan.planning.guard import Guard, GuardCache
 from kcplan.planning.ladder import GuardLadder
 from kcplan.world.occupancy import CoreOccupancy
 
-__all__ = ["CERTIFICATE_SETS", "COUNTER_NAMES", "EdgeCertifier", "check_certificates"]
+__all__ = [
+    "CERTIFICATE_SETS",
+    "COUNTER_NAMES",
+    "DEFAULT_PROBES",
+    "EdgeCertifier",
+    "check_certificates",
+    "probe_points",
+]
 
 CERTIFICATE_SETS = {
     "ca": ("ball",),
@@ -45,6 +52,7 @@ COUNTER_NAMES = (
     "rejected_end_state",
     "rejected_sweep",
     "rejected_occupancy",
+    "rejected_probe",
     "rejected_guard",
     "not_proven",
     "certified_by_endpoints",
@@ -56,7 +64,12 @@ COUNTER_NAMES = (
     "collision_queries",
     "occupancy_rejections",
     "occupancy_queries",
+    "probes",
 )
+
+DEFAULT_PROBES = 3
+"""Collision probes per edge before its guards (step 3). Chosen by the ablation of
+``benchmarks/RESULTS.md`` section 10 (``kc-rrtconnect-noprobe``: none)."""
 
 
 class EdgeCertifier:
@@ -76,7 +89,10 @@ class EdgeCertifier:
        centre, so the edge collides if its centre passes through a cell the occupancy
        grid knows blocked (no query; done in step 1 unless ``p2`` was cached), or
        (``sweep_test``) if the capsule swept by that ball over ``[lo, hi]`` meets an
-       obstacle (one collision query).
+       obstacle (one collision query). Then ``probes`` collision queries at the bisection
+       points 1/2, 1/4, 3/4, 1/8, ... of ``[lo, hi]`` (:func:`probe_points`): a colliding
+       pose proves the edge not free (``rejected_probe``) at a collision query's price,
+       before any guard is paid for.
     4. Missing endpoint guards are measured and cached (a state the planner keeps is
        never queried twice).
     5. Advancement: a guard at the middle of each open stretch, removing what it covers,
@@ -119,6 +135,8 @@ class EdgeCertifier:
         blocked for every orientation, with no query; a cell is tested (one query) the
         first time a state in it collides (default: when the world has
         ``ball_collides`` and ``scenario``).
+    probes : int
+        Collision probes per edge in step 3 (0: none).
 
     Steps 1 and 3 use the robot's core, the ball of radius
     :attr:`kcplan.geometry.robot.Robot.core_radius` about its origin; a robot whose
@@ -148,6 +166,7 @@ class EdgeCertifier:
         sweep_test: bool | None = None,
         cache: GuardCache | None = None,
         occupancy: bool | None = None,
+        probes: int = DEFAULT_PROBES,
     ):
         regions = hasattr(world, "free_regions")
         if certificates is None:
@@ -184,6 +203,9 @@ class EdgeCertifier:
         self.margin = float(getattr(world, "clearance_atol", 0.0)) + 1e-12 * robot.reach
         self.fallback = fallback
         self.max_guards = int(max_guards)
+        if not (isinstance(probes, int) and probes >= 0):
+            raise ValueError(f"probes: expected a number >= 0, got {probes!r}")
+        self.probes = probes
         self.sweep_test = bool(sweep_test)
         self.cache = cache if cache is not None else GuardCache()
         self.occupancy = occupancy
@@ -327,6 +349,8 @@ class EdgeCertifier:
             c["collision_queries"] += 1
             if self.world.sweep_core_collides(edge.pose(lo), edge.pose(hi), self.core_radius):
                 return self._reject("rejected_sweep")
+        if not self._probe(edge, lo, hi):
+            return self._reject("rejected_probe")
         if g1 is None:
             g1 = self._endpoint(p1, k1)
             if g1.clearance <= 0.0:
@@ -343,6 +367,15 @@ class EdgeCertifier:
         if self.fallback == "discrete":
             return self._sample(edge, resolution, lo, hi)
         return self._advance(edge, lo, hi)
+
+    def _probe(self, edge: Edge, lo: float, hi: float) -> bool:
+        """False when one of the probes of ``[lo, hi]`` collides."""
+        for u in probe_points(self.probes):
+            self.counters["probes"] += 1
+            self.counters["collision_queries"] += 1
+            if self.world.in_collision(edge.pose(lo + u * (hi - lo))):
+                return False
+        return True
 
     def _advance(self, edge: Edge, lo: float, hi: float) -> bool:
         c = self.counters
@@ -381,6 +414,20 @@ class EdgeCertifier:
             if self.world.in_collision(edge.pose(s)):
                 return self._reject("rejected_guard")
         return True
+
+
+def probe_points(count: int) -> list[float]:
+    """The first ``count`` points of the van der Corput sequence, 1/2, 1/4, 3/4, 1/8, 5/8,
+    3/8, 7/8, 1/16, ...: each halves the largest stretch of ``[0, 1]`` not yet probed, in
+    the order bisection would reach it (exact in binary floating point)."""
+    out = []
+    for i in range(1, count + 1):
+        u, bit = 0.0, 0.5
+        while i:
+            u += bit * (i & 1)
+            i, bit = i >> 1, bit * 0.5
+        out.append(u)
+    return out
 
 
 def check_certificates(

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan._kernel import EdgeCertifier as _CompiledCertifier
-from kcplan.planning.certifier import CERTIFICATE_SETS, check_certificates
+from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
 from kcplan.planning.ladder import GuardLadder
 
 __all__ = ["KernelCertifier"]
@@ -30,7 +30,7 @@ class KernelCertifier:
     world : kcplan.world.CollisionWorld
         Its :attr:`~kcplan.world.CollisionWorld.kernel` is used (built on first use); the
         certifier's queries show in ``world.counters``.
-    certificates, ladder, horizon, fallback, max_guards, sweep_test, occupancy
+    certificates, ladder, horizon, fallback, max_guards, sweep_test, occupancy, probes
         As for :class:`~kcplan.planning.certifier.EdgeCertifier` (``sweep_test`` and
         ``occupancy`` default to on; both need a robot core).
     cache_entries : int
@@ -54,6 +54,7 @@ class KernelCertifier:
         sweep_test: bool | None = None,
         occupancy: bool | None = None,
         cache_entries: int = 200_000,
+        probes: int = DEFAULT_PROBES,
     ):
         robot = world.robot
         certificates = tuple(CERTIFICATE_SETS["kc"] if certificates is None else certificates)
@@ -78,6 +79,7 @@ class KernelCertifier:
             -1.0 if horizon is None else float(horizon),
             True if sweep_test is None else bool(sweep_test),
             True if occupancy is None else bool(occupancy),
+            int(probes),
             low + pad,
             high + pad,
             int(cache_entries),
@@ -89,6 +91,7 @@ class KernelCertifier:
         self.margin = self._kernel.margin
         self.sweep_test = self._kernel.sweep_test
         self.occupancy = self._kernel.occupancy
+        self.probes = self._kernel.probes
         # the validator's hot path calls these directly (one Python call per edge)
         self.check_se2, self.check_se3 = self._kernel.check_se2, self._kernel.check_se3
         self.state_valid_se2 = self._kernel.state_valid_se2

@@ -31,6 +31,8 @@ PLANNER_NAMES = (
     "kc-rrtconnect-paper",
     "kc-prm-paper",
     "kc-rrtconnect-discrete",
+    "kc-rrtconnect-noprobe",
+    "kc-prm-noprobe",
     "kc-rrtconnect-py",
     "kc-prm-py",
     *STOCK,

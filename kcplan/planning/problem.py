@@ -16,7 +16,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from kcplan.planning.certifier import CERTIFICATE_SETS
+from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, STOCK, check_planner_name
 from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.states import set_state, state_pose, state_space
@@ -48,6 +48,7 @@ class PlannerSpec:
     range_factor: float | None = None  # RRT-Connect range, fraction of the maximum extent
     neighbors: int | None = None  # PRM's maximum nearest neighbours (OMPL default 10)
     backend: str = "kernel"
+    probes: int = DEFAULT_PROBES  # collision probes per edge before its guards (kc)
 
     @property
     def kc(self) -> bool:
@@ -87,6 +88,18 @@ PLANNERS: dict[str, PlannerSpec] = {
         "discrete",
         "RRT-Connect with endpoint guards, then OMPL-style sampling (the design card's "
         "plain variant; not exact)",
+    ),
+    "kc-rrtconnect-noprobe": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation: kc-rrtconnect without collision probes before the guards",
+        probes=0,
+    ),
+    "kc-prm-noprobe": PlannerSpec(
+        og.PRM,
+        _KC,
+        description="ablation: kc-prm without collision probes before the guards",
+        probes=0,
     ),
     "kc-rrtconnect-py": PlannerSpec(
         og.RRTConnect,
@@ -305,7 +318,13 @@ def plan(
     validator = None
     if spec.kc:
         validator = KCMotionValidator(
-            si, world.robot, world, spec.certificates, spec.fallback, backend=spec.backend
+            si,
+            world.robot,
+            world,
+            spec.certificates,
+            spec.fallback,
+            backend=spec.backend,
+            probes=spec.probes,
         )
         si.setMotionValidator(validator)
         state_valid = validator.state_valid  # shares the validator's guard cache

@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike
 from ompl import base as ob
 
 from kcplan.geometry.robot import Robot
-from kcplan.planning.certifier import EdgeCertifier
+from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import state_pose
@@ -76,6 +76,10 @@ class KCMotionValidator(ob.MotionValidator):
         Reject an edge whose robot core (ball of radius ``min(a)`` for one body) sweeps into an
         obstacle with one collision query before measuring guards (default: when the
         world has ``sweep_core_collides``).
+    probes : int
+        Collision queries at bisection points of an edge before its guards, so that a
+        colliding edge is rejected at a collision query's price (default
+        :data:`kcplan.planning.certifier.DEFAULT_PROBES`; 0: none).
     backend : {"kernel", "python"}, optional
         Who decides: the compiled kernel (:class:`kcplan.planning.kernel.KernelCertifier`,
         on coal; the default for a :class:`kcplan.CollisionWorld`, whose robot it
@@ -97,6 +101,7 @@ class KCMotionValidator(ob.MotionValidator):
         max_guards: int = 64,
         sweep_test: bool | None = None,
         backend: str | None = None,
+        probes: int = DEFAULT_PROBES,
     ):
         super().__init__(si)
         self.space = si.getStateSpace()  # not si itself: see the module docstring
@@ -118,12 +123,14 @@ class KCMotionValidator(ob.MotionValidator):
             if world.robot is not robot and robot.to_spec() != world.robot.to_spec():
                 raise ValueError("robot: the kernel certifies the world's own robot; got another")
             self.certifier = KernelCertifier(
-                world, certificates, ladder, horizon, fallback, max_guards, sweep_test
-            )
+                world, certificates, ladder, horizon, fallback, max_guards, sweep_test,
+                probes=probes,
+            )  # fmt: skip
         else:
             self.certifier = EdgeCertifier(
-                world, robot, certificates, ladder, horizon, fallback, max_guards, sweep_test
-            )
+                world, robot, certificates, ladder, horizon, fallback, max_guards, sweep_test,
+                probes=probes,
+            )  # fmt: skip
         self.backend = backend
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
