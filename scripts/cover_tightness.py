@@ -10,7 +10,9 @@ triangles). Writes a markdown table, a CSV and a plot::
 
 The default meshes are the Panda hand, link0 and link3 and the UR5 upper arm and forearm
 collision meshes (``../shared/data/external/example-robot-data``) and the L-bracket CAD
-part of the suite; ``--meshes`` gives others.
+part of the suite; ``--meshes`` gives others. Then come the generated parts of
+:mod:`kcplan.cover.profiles` (a thick ring, a U-channel, a T-profile, a pipe), chosen by
+``--profiles``.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import time
 from pathlib import Path
 
 from kcplan.cover import fit_cover, read_solid, union_volume
+from kcplan.cover.profiles import PROFILES
 from kcplan.files import write_text_atomic
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -41,6 +44,15 @@ DEFAULT_MESHES = [
 
 def label(path: Path) -> str:
     return f"{path.parent.name}/{path.name}"
+
+
+def write_profiles(names: list[str], folder: Path) -> list[Path]:
+    """Write the generated parts ``names`` as STL files into ``folder/generated``."""
+    (folder / "generated").mkdir()
+    paths = [folder / "generated" / f"{name}.stl" for name in names]
+    for name, path in zip(names, paths, strict=True):
+        PROFILES[name]().export(path)
+    return paths
 
 
 def tightness(paths: list[Path], bodies: list[int], samples: int) -> list[dict]:
@@ -151,6 +163,11 @@ def plot(rows: list[dict], path: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", nargs="+", type=Path, help="meshes (default: see above)")
+    parser.add_argument(
+        "--profiles",
+        default=",".join(PROFILES),
+        help=f"generated parts, comma-separated, or '' (default {','.join(PROFILES)})",
+    )
     parser.add_argument("--bodies", default="1,2,3,4,5,6,7,8", help="K values (default 1..8)")
     parser.add_argument("--samples", type=int, default=400_000, help="Monte Carlo samples")
     parser.add_argument("--timing", default="4,8", help="K values for the fit-time runs, or ''")
@@ -165,9 +182,11 @@ def main() -> None:
     args = parser.parse_args()
     paths = args.meshes or [p for p in DEFAULT_MESHES if p.is_file()]
     bodies = [int(k) for k in args.bodies.split(",")]
-    rows = tightness(paths, bodies, args.samples)
-    big = args.timing_mesh if args.timing_mesh.is_file() else paths[0]
-    timing = fit_times(big, [int(k) for k in args.timing.split(",") if k])
+    with tempfile.TemporaryDirectory() as tmp:
+        paths += write_profiles([n for n in args.profiles.split(",") if n], Path(tmp))
+        rows = tightness(paths, bodies, args.samples)
+        big = args.timing_mesh if args.timing_mesh.is_file() else paths[0]
+        timing = fit_times(big, [int(k) for k in args.timing.split(",") if k])
     table = markdown(rows, timing, args.samples)
     print(table)
     if args.out:

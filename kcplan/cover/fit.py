@@ -47,7 +47,7 @@ from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 
 __all__ = ["FIT_VERSION", "SHAPES", "Cover", "check_cover", "fit_cover"]
 
-FIT_VERSION = 1
+FIT_VERSION = 2
 """Changes whenever the fit would give other bodies for the same input (cache key)."""
 SHAPES = ("ellipsoid", "sphere")
 CUT_QUANTILES = (0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875)
@@ -57,6 +57,20 @@ FINAL_TOL = 1e-4
 """Khachiyan tolerance of the bodies kept (volume within about 0.015 % of the MVEE's)."""
 SCORE_SAMPLES = 2**15
 """Quasi-random points that score candidate cuts."""
+FACE_SHARE = 0.01
+"""A plane of the part's faces is a candidate cut when its faces carry this share of the
+part's surface (so a curved mesh, whose facets are all small, adds none)."""
+FACE_PLANES = 8
+"""At most this many face planes per piece, those of the largest faces."""
+PLANE_TOL = 1e-6
+"""Faces whose unit normals and offsets (over the part's size) agree to this share a plane."""
+PENCIL_ANGLES = 6
+"""Planes through each axis of the part's ellipsoid, every 180 / this degrees."""
+SECTORS = True
+"""Also try the part cut into equal sectors about an axis of its ellipsoid."""
+LOOKAHEAD = 3
+"""When no single cut shrinks the union, this many best cuts of each leaf are tried as
+the first of two."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,13 +123,14 @@ class Cover:
 
 @dataclass(eq=False)
 class _Leaf:
-    node: dict
+    node: dict  # the leaf's node of the cutting tree
     piece: Piece
     points: NDArray  # the piece's hull points (partition.Piece.points), which M holds
     center: NDArray
     M: NDArray
-    candidates: list | None = None  # from _candidates(), once computed
-    split: tuple | None = None  # (gain, normal, offset) under the current union
+    inside: NDArray[np.bool_]  # the score sample's points in the ellipsoid
+    outside: float  # the ellipsoid's volume outside the sampled region
+    candidates: list | None = None  # from _Search.candidates(), once computed
 
 
 def _enclosing(points: NDArray, shape: str, tol: float) -> tuple[NDArray, NDArray]:
@@ -151,6 +166,79 @@ def _directions(M: NDArray) -> list[NDArray]:
     return out
 
 
+def _face_planes(boundary: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """The distinct planes of the part's boundary simplices that carry at least
+    :data:`FACE_SHARE` of its surface, largest first.
+
+    Returns
+    -------
+    normals : ndarray, shape (m, n)
+        Unit normals, signed so that the largest component is positive.
+    offsets : ndarray, shape (m,)
+    areas : ndarray, shape (m,)
+        Area (length in 2D) of the boundary on each plane.
+    """
+    n = boundary.shape[-1]
+    if n == 3:
+        normal = np.cross(boundary[:, 1] - boundary[:, 0], boundary[:, 2] - boundary[:, 0])
+    else:
+        d = boundary[:, 1] - boundary[:, 0]
+        normal = np.stack([d[:, 1], -d[:, 0]], axis=1)
+    length = np.linalg.norm(normal, axis=1)
+    area = length / (2.0 if n == 3 else 1.0)
+    keep = length > 0
+    normal = normal[keep] / length[keep, None]
+    sign = np.sign(normal[np.arange(len(normal)), np.abs(normal).argmax(axis=1)])
+    normal *= sign[:, None]
+    offset = np.einsum("ij,ij->i", normal, boundary[keep, 0])
+    size = float(np.ptp(boundary.reshape(-1, n), axis=0).max())
+    key = np.round(np.column_stack([normal / PLANE_TOL, offset / (PLANE_TOL * size)]))
+    _, group = np.unique(key, axis=0, return_inverse=True)
+    group = group.reshape(-1)
+    weight = area[keep]
+    total = np.bincount(group, weight)
+    normals = np.stack([np.bincount(group, weight * normal[:, j]) for j in range(n)], axis=1)
+    offsets = np.bincount(group, weight * offset) / total
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    order = np.argsort(-total)
+    order = order[total[order] >= FACE_SHARE * area.sum()]
+    return normals[order], offsets[order], total[order]
+
+
+def _pencil_normal(R: NDArray, axis: int, angle: float) -> NDArray:
+    """The unit normal of the plane through the ellipsoid's axis ``axis`` (columns of
+    ``R``; in 2D, the line through the centre) at ``angle`` from the next axis: a point
+    at angle ``t`` about the axis lies below the plane when ``sin(t - angle) <= 0``."""
+    n = len(R)
+    i, j = (0, 1) if n == 2 else ((axis + 1) % 3, (axis + 2) % 3)
+    return -np.sin(angle) * R[:, i] + np.cos(angle) * R[:, j]
+
+
+def _pencils(center: NDArray, R: NDArray) -> tuple[NDArray, NDArray]:
+    """Planes through the centre of the part's ellipsoid that contain one of its axes
+    (columns of ``R``), at :data:`PENCIL_ANGLES` angles about it (in 2D: lines through the
+    centre), as unit ``normals (m, n)`` and ``offsets (m,)``. A ring's hole is on such an
+    axis, and the planes through it cut the ring into sectors."""
+    out: list[NDArray] = []
+    for axis in range(len(R) if len(R) == 3 else 1):
+        for t in np.pi * np.arange(PENCIL_ANGLES) / PENCIL_ANGLES:
+            normal = _pencil_normal(R, axis, t)
+            if all(abs(float(normal @ d)) < 0.999 for d in out):
+                out.append(normal)
+    normals = np.array(out)
+    return normals, normals @ center
+
+
+def _crossing(V: NDArray, normals: NDArray, offsets: NDArray) -> NDArray[np.bool_]:
+    """Which planes have points of ``V`` strictly on both sides (beyond a millionth of
+    the points' extent), so that they cut the piece into two pieces with volume."""
+    if len(normals) == 0:
+        return np.zeros(0, dtype=bool)
+    d = V @ normals.T - offsets  # (points, planes)
+    margin = 1e-6 * float(np.ptp(V, axis=0).max())
+    return (d.min(axis=0) < -margin) & (d.max(axis=0) > margin)
+
+
 class _Scorer:
     """Union volume on a fixed quasi-random sample of the part's bounding box, padded by a
     tenth (what a body has outside the box is added from its exact volume)."""
@@ -171,6 +259,149 @@ class _Scorer:
         """Volume of an ellipsoid outside the sampled region (exact volume less the
         sampled part), so that a cut cannot hide volume there."""
         return max(0.0, ellipsoid_volume(M) - float(inside.sum()) * self.cell)
+
+    def union(self, inside: NDArray[np.bool_], outside: float) -> float:
+        """The union's volume from its sampled points and its volume outside."""
+        return int(inside.sum()) * self.cell + outside
+
+
+class _Search:
+    """What the search needs of a part: its fitted leaves and their candidate cuts."""
+
+    def __init__(self, solid: Solid, shape: str, pencils: bool):
+        self.solid = solid
+        self.shape = shape
+        self.scorer = _Scorer(solid)
+        self.faces = _face_planes(solid.boundary)[:2] if FACE_PLANES else None
+        self.root = self.leaf(Piece.whole(solid.boundary))
+        self.axes = ellipsoid_axes(self.root.M)[1]
+        self.pencils = _pencils(self.root.center, self.axes) if pencils else None
+
+    def leaf(self, piece: Piece) -> _Leaf:
+        """A leaf of the piece, its ellipsoid fitted to its full hull points."""
+        points = piece.points(self.solid.boundary)
+        c, M = _enclosing(points, self.shape, FINAL_TOL)
+        inside = self.scorer.inside(c, M)
+        return _Leaf({}, piece, points, c, M, inside, self.scorer.outside(M, inside))
+
+    def children(self, leaf: _Leaf, normal: NDArray, offset: float) -> tuple[_Leaf, _Leaf]:
+        """The leaves below and above the plane ``normal . x = offset``."""
+        return (
+            self.leaf(leaf.piece.cut(normal, offset)),
+            self.leaf(leaf.piece.cut(-normal, -offset)),
+        )
+
+    def union(self, leaves: list[_Leaf]) -> float:
+        """The union's volume of the leaves' ellipsoids (sample estimate)."""
+        inside = np.logical_or.reduce([leaf.inside for leaf in leaves])
+        return self.scorer.union(inside, sum(leaf.outside for leaf in leaves))
+
+    def sectors(self, axis: int, m: int) -> tuple[dict, list[_Leaf]]:
+        """The part cut into ``m`` (even) equal sectors about an axis of its ellipsoid by
+        planes through the axis (:func:`_pencil_normal`): a fresh tree and its leaves."""
+        R, center = self.axes, self.root.center
+
+        def split(node: dict, piece: Piece, low: float, high: float, j: int) -> list[_Leaf]:
+            """Sectors ``j`` of the angles ``[low, high]`` (at most a half turn apart, or
+            the whole turn at the root) of ``piece``, whose tree node is ``node``."""
+            if j == 1:
+                leaf = self.leaf(piece)
+                leaf.node = node
+                return [leaf]
+            angle = low + (high - low) * (j // 2) / j
+            normal = _pencil_normal(R, axis, angle)
+            offset = float(normal @ center)
+            node |= {"plane": [*normal.tolist(), offset], "below": {}, "above": {}}
+            below = split(node["below"], piece.cut(normal, offset), low, angle, j // 2)
+            above = piece.cut(-normal, -offset)
+            return below + split(node["above"], above, angle, high, j - j // 2)
+
+        root: dict = {}
+        return root, split(root, self.root.piece, -np.pi, np.pi, m)
+
+    def planes(self, leaf: _Leaf) -> list[tuple[NDArray, float]]:
+        """Candidate cuts of a leaf as ``(normal, offset)``: across its ellipsoid's and the
+        frame's axes at :data:`CUT_QUANTILES`, then the part's largest face planes and the
+        planes of :func:`_pencils` that cross the piece."""
+        V = leaf.piece.boundary_points
+        out = [
+            (normal, float(offset))
+            for normal in _directions(leaf.M)
+            for offset in np.unique(np.quantile(V @ normal, CUT_QUANTILES))
+        ]
+        if self.faces is not None:
+            normals, offsets = self.faces
+            cross = np.flatnonzero(_crossing(V, normals, offsets))[:FACE_PLANES]
+            out += [(normals[i], float(offsets[i])) for i in cross]
+        if self.pencils is not None:
+            normals, offsets = self.pencils
+            cross = np.flatnonzero(_crossing(V, normals, offsets))
+            out += [(normals[i], float(offsets[i])) for i in cross]
+        return out
+
+    def candidates(self, leaf: _Leaf) -> list[tuple]:
+        """Candidate cuts of ``leaf`` as ``(normal, offset, covered, outside)``: the sample
+        points the two children's ellipsoids (fitted to their clipped boundary points)
+        hold, and their volume outside the sampled region."""
+        if leaf.candidates is not None:
+            return leaf.candidates
+        out = []
+        n = self.solid.dimension
+        for normal, offset in self.planes(leaf):
+            covered = np.zeros(len(self.scorer.points), dtype=bool)
+            outside = 0.0
+            for sign in (1.0, -1.0):
+                part = leaf.piece.cut(sign * normal, sign * offset).boundary
+                if len(part) == 0:
+                    break
+                c, M = _enclosing(part.reshape(-1, n), self.shape, SEARCH_TOL)
+                inside = self.scorer.inside(c, M)
+                covered |= inside
+                outside += self.scorer.outside(M, inside)
+            else:
+                out.append((normal, offset, covered, outside))
+        leaf.candidates = out
+        return out
+
+    def ranked_cuts(self, leaves: list[_Leaf], k: int) -> list[tuple[float, NDArray, float]]:
+        """The candidate cuts of ``leaves[k]`` as ``(union volume, normal, offset)``, the
+        smallest union first."""
+        rest = np.zeros(len(self.scorer.points), dtype=bool)
+        outside = 0.0
+        for j, other in enumerate(leaves):
+            if j != k:
+                rest |= other.inside
+                outside += other.outside
+        out = [
+            (self.scorer.union(rest | covered, outside + extra), normal, offset)
+            for normal, offset, covered, extra in self.candidates(leaves[k])
+        ]
+        return sorted(out, key=lambda cut: cut[0])
+
+    def best_cut(self, leaves: list[_Leaf]) -> tuple[float, int, NDArray, float]:
+        """The single cut of any leaf that leaves the smallest union: ``(union volume,
+        leaf index, normal, offset)``."""
+        best = (np.inf, -1, None, 0.0)
+        for k in range(len(leaves)):
+            cuts = self.ranked_cuts(leaves, k)
+            if cuts and cuts[0][0] < best[0]:
+                best = (cuts[0][0], k, cuts[0][1], cuts[0][2])
+        return best
+
+    def best_pair(self, leaves: list[_Leaf]) -> tuple[float, int, NDArray, float, tuple]:
+        """The best sequence of two cuts, the first among the :data:`LOOKAHEAD` best cuts
+        of each leaf (its children fitted as if chosen), the second any single cut of the
+        leaves then: ``(union volume after both, leaf index, normal, offset, children)``
+        of the first."""
+        best = (np.inf, -1, None, 0.0, ())
+        for k in range(len(leaves)):
+            for _, normal, offset in self.ranked_cuts(leaves, k)[:LOOKAHEAD]:
+                children = self.children(leaves[k], normal, offset)
+                after = [*leaves[:k], *leaves[k + 1 :], *children]
+                union = self.best_cut(after)[0]
+                if union < best[0]:
+                    best = (union, k, normal, offset, children)
+        return best
 
 
 def fit_cover(
@@ -209,93 +440,114 @@ def fit_cover(
     if max_excess is not None and not max_excess > 0:
         raise ValueError(f"max_excess: expected a positive number, got {max_excess}")
     start = time.perf_counter()
+    searches = [_Search(solid, shape, pencils=False)]
+    if PENCIL_ANGLES:
+        searches.append(_Search(solid, shape, pencils=True))
     target = bodies if bodies is not None else MAX_BODIES
-    whole = Piece.whole(solid.boundary)
-    points = whole.points(solid.boundary)
-    c, M = _enclosing(points, shape, FINAL_TOL)
-    root: dict = {}
-    leaves = [_Leaf(root, whole, points, c, M)]
-    scorer = _Scorer(solid)
-    inside = [scorer.inside(c, M)]
-    note = ""
+
+    def reporter(label: str) -> Callable[[int], None]:
+        def report(count: int) -> None:
+            if progress is not None:
+                progress(f"{label}: {count} bodies, {time.perf_counter() - start:.1f} s")
+
+        return report
+
+    growths = [
+        _grow(s, s.root.node, [s.root], target, max_excess, reporter(f"search {k + 1}"))
+        for k, s in enumerate(searches)
+    ]
+    if bodies is not None and SECTORS:
+        sectors = _best_sectors(searches[-1], bodies, growths)
+        if sectors is not None:
+            growths.append(_grow(searches[-1], *sectors, bodies, None, reporter("sectors")))
+    if max_excess is None:
+        growth = min(growths, key=lambda g: g.union)
+    else:  # the fewest bodies within the bound, then the smallest union
+        growth = min(growths, key=lambda g: (len(g.leaves), g.union))
+        total = sum(ellipsoid_volume(leaf.M) for leaf in growth.leaves)
+        if len(growth.leaves) == MAX_BODIES and total > (1.0 + max_excess) * solid.volume:
+            growth.note = f"stopped at {MAX_BODIES} bodies, the most a robot may have"
+    out = []
+    for k, leaf in enumerate(growth.leaves):
+        leaf.node["body"] = k
+        out.append(_sound_body(leaf, shape))
+    worst = max(
+        body_holds(body, leaf.points) for body, leaf in zip(out, growth.leaves, strict=True)
+    )
+    seconds = time.perf_counter() - start
+    return Cover(solid, tuple(out), growth.root, shape, seconds, growth.note, worst)
+
+
+@dataclass(eq=False)
+class _Growth:
+    """A cutting tree grown by :func:`_grow`."""
+
+    root: dict
+    leaves: list[_Leaf]
+    note: str  # why it stopped before the number of bodies asked for, or empty
+    trail: dict[int, float]  # the union's volume (sample estimate) at each leaf count
+
+    @property
+    def union(self) -> float:
+        return self.trail[len(self.leaves)]
+
+
+def _grow(
+    search: _Search,
+    root: dict,
+    leaves: list[_Leaf],
+    target: int,
+    max_excess: float | None,
+    report: Callable[[int], None],
+) -> _Growth:
+    """Cut the leaves of the tree ``root``, one cut at a time, until there are ``target``
+    of them (see the module docstring), or until the bodies' total volume is within
+    ``1 + max_excess`` of the part's. The leaves' tree nodes get planes and children."""
+    growth = _Growth(root, list(leaves), "", {len(leaves): search.union(leaves)})
+    leaves = growth.leaves
     while len(leaves) < target:
         if max_excess is not None:
             total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
-            if total <= (1.0 + max_excess) * solid.volume:
+            if total <= (1.0 + max_excess) * search.solid.volume:
                 break
-        for k, leaf in enumerate(leaves):
-            if leaf.split is None:
-                others = np.zeros(len(scorer.points), dtype=bool)
-                for j, mask in enumerate(inside):
-                    if j != k:
-                        others |= mask
-                if leaf.candidates is None:
-                    leaf.candidates = _candidates(solid, leaf, shape, scorer)
-                leaf.split = _best_cut(leaf, scorer, others)
-        k = max(range(len(leaves)), key=lambda i: leaves[i].split[0])
-        gain, normal, offset = leaves[k].split[:3]
-        if gain <= 0:
-            note = f"stopped at {len(leaves)} bodies: no cut made the cover smaller"
+        union, k, normal, offset = search.best_cut(leaves)
+        if union < growth.union:
+            children = search.children(leaves[k], normal, offset)
+        elif len(leaves) + 2 > target or not LOOKAHEAD:
+            growth.note = f"stopped at {len(leaves)} bodies: no cut made the cover smaller"
             break
+        else:
+            union, k, normal, offset, children = search.best_pair(leaves)
+            if not union < growth.union:
+                growth.note = (
+                    f"stopped at {len(leaves)} bodies: no sequence of two cuts made the "
+                    "cover smaller"
+                )
+                break
         leaf = leaves.pop(k)
-        inside.pop(k)
-        leaf.node["plane"] = [*normal.tolist(), float(offset)]
-        for side, sign in (("below", 1.0), ("above", -1.0)):
-            piece = leaf.piece.cut(sign * normal, sign * offset)
-            points = piece.points(solid.boundary)
-            c, M = _enclosing(points, shape, FINAL_TOL)
-            leaf.node[side] = {}
-            leaves.append(_Leaf(leaf.node[side], piece, points, c, M))
-            inside.append(scorer.inside(c, M))
-        for other in leaves:  # the union changed: every score is stale
-            other.split = None
-        if progress is not None:
-            progress(f"{len(leaves)} bodies, {time.perf_counter() - start:.1f} s")
-    if max_excess is not None and len(leaves) == MAX_BODIES:
-        total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
-        if total > (1.0 + max_excess) * solid.volume:
-            note = f"stopped at {MAX_BODIES} bodies, the most a robot may have"
-    out = []
-    for k, leaf in enumerate(leaves):
-        leaf.node["body"] = k
-        out.append(_sound_body(leaf, shape))
-    worst = max(body_holds(body, leaf.points) for body, leaf in zip(out, leaves, strict=True))
-    return Cover(solid, tuple(out), root, shape, time.perf_counter() - start, note, worst)
+        leaf.node |= {"plane": [*normal.tolist(), float(offset)]}
+        leaf.node |= {"below": children[0].node, "above": children[1].node}
+        leaves += children
+        growth.trail[len(leaves)] = search.union(leaves)
+        report(len(leaves))
+    return growth
 
 
-def _candidates(solid: Solid, leaf: _Leaf, shape: str, scorer: _Scorer) -> list[tuple]:
-    """Candidate cuts of ``leaf`` as ``(normal, offset, covered, outside)``: the sample
-    points the two children's ellipsoids (fitted to their clipped boundary points) hold,
-    and their volume outside the sampled region."""
-    out = []
-    V = leaf.piece.boundary_points
-    for normal in _directions(leaf.M):
-        for offset in np.unique(np.quantile(V @ normal, CUT_QUANTILES)):
-            covered = np.zeros(len(scorer.points), dtype=bool)
-            outside = 0.0
-            for sign in (1.0, -1.0):
-                part = leaf.piece.cut(sign * normal, sign * offset).boundary
-                if len(part) == 0:
-                    break
-                c, M = _enclosing(part.reshape(-1, solid.dimension), shape, SEARCH_TOL)
-                inside = scorer.inside(c, M)
-                covered |= inside
-                outside += scorer.outside(M, inside)
-            else:
-                out.append((normal, float(offset), covered, outside))
-    return out
-
-
-def _best_cut(leaf: _Leaf, scorer: _Scorer, others: NDArray) -> tuple:
-    """The candidate cut of ``leaf`` that leaves the smallest union: ``(gain, normal,
-    offset)`` with the gain in volume units (may be negative)."""
-    inside = scorer.inside(leaf.center, leaf.M)
-    base = int((others | inside).sum()) * scorer.cell + scorer.outside(leaf.M, inside)
-    best = (-np.inf, None, None)
-    for normal, offset, covered, outside in leaf.candidates:
-        gain = base - int((others | covered).sum()) * scorer.cell - outside
-        if gain > best[0]:
-            best = (gain, normal, offset)
+def _best_sectors(
+    search: _Search, bodies: int, growths: list[_Growth]
+) -> tuple[dict, list[_Leaf]] | None:
+    """The part cut into an even number ``m`` (4 to ``bodies``) of equal sectors about
+    one axis of its ellipsoid (:meth:`_Search.sectors`), the ``m`` and axis whose union
+    is smallest, if that is smaller than any union the cut-by-cut ``growths`` reached
+    with at most ``m`` leaves; else None."""
+    best, best_union = None, np.inf
+    for m in range(4, bodies + 1, 2):
+        reached = min(u for g in growths for count, u in g.trail.items() if count <= m)
+        for axis in range(search.solid.dimension if search.solid.dimension == 3 else 1):
+            root, leaves = search.sectors(axis, m)
+            union = search.union(leaves)
+            if union < min(best_union, reached):
+                best, best_union = (root, leaves), union
     return best
 
 
