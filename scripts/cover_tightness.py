@@ -128,7 +128,8 @@ def markdown(rows: list[dict], timing: list[dict], samples: int) -> str:
             f"{r['excess_ratio']:.2f} | {r['ellipsoid_seconds']:.1f} |"
         )
     if stopped:
-        out += ["", "(N bodies): the fit stopped there, no cut made the union smaller."]
+        out += ["", "(N bodies): the fit stopped there (see `Cover.note`): no cut, nor any "
+                "sequence of two cuts, made the union smaller."]  # fmt: skip
     if timing:
         out += [
             "",

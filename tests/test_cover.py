@@ -31,6 +31,7 @@ from kcplan.cover import (
 )
 from kcplan.cover.cache import cache_folder, cached_cover
 from kcplan.cover.partition import Piece, clip_simplices
+from kcplan.cover.profiles import PROFILES
 from kcplan.geometry.enclosing import (
     ellipsoid_axes,
     ellipsoid_volume,
@@ -247,6 +248,38 @@ def test_a_torus_and_a_2d_outline_with_a_notch_are_covered(tmp_path):
     cover2 = fit_cover(outline, bodies=3)
     _assert_covered(outline, cover2, None, SAMPLES)
     assert math.isclose(outline.volume, 52.0)
+
+
+@pytest.mark.parametrize(
+    ("name", "most"),
+    [("ring", 2.1), ("u_channel", 2.5)],
+)
+def test_the_fit_gets_past_local_minima_of_the_greedy_tree(tmp_path, name, most):
+    """Issue 26: the greedy tree stopped the thick ring at 2 bodies (2.23: its first cut
+    makes two flat rings, and no one cut of either helps); the ring is cut into 4 sectors
+    about its axis now. Held to the bound with three standard errors to spare."""
+    PROFILES[name]().export(tmp_path / f"{name}.stl")
+    solid = read_solid(tmp_path / f"{name}.stl")
+    cover = fit_cover(solid, bodies=4)
+    assert len(cover.bodies) == 4 and cover.note == ""
+    volume, error = union_volume(cover.bodies, 200_000)
+    assert (volume + 3 * error) / solid.volume <= most
+    assert check_cover(solid, cover.tree, cover.bodies) <= 1.0
+    assert cover.worst <= 1.0
+
+
+def test_fewer_bodies_only_when_no_two_cuts_make_the_cover_smaller(tmp_path):
+    """A ball is its own best cover: no cut, nor sequence of two, shrinks the union, and
+    the note says which was tried."""
+    trimesh.creation.icosphere(1).export(tmp_path / "ball.stl")
+    solid = read_solid(tmp_path / "ball.stl")
+    two = fit_cover(solid, bodies=2)
+    assert len(two.bodies) == 1
+    assert two.note == "stopped at 1 body: no cut made the cover smaller"
+    three = fit_cover(solid, bodies=3)
+    assert len(three.bodies) == 1
+    assert three.note == "stopped at 1 body: no sequence of two cuts made the cover smaller"
+    assert check_cover(solid, three.tree, three.bodies) <= 1.0
 
 
 def _star_solid(seed: int) -> trimesh.Trimesh:

@@ -112,10 +112,11 @@ CASES = [
         "cover_tightness.py",
         ("--meshes", "scenarios/3d/meshes/l_bracket.stl", "--bodies", "1,2", "--samples")
         + ("20000", "--timing", "1", "--timing-mesh", "scenarios/3d/meshes/rock.stl")
-        + ("--out", "{tmp}"),
+        + ("--profiles", "u_channel", "--out", "{tmp}"),
         (
             rf"^\| meshes/l_bracket\.stl \| 20 \| 2 \| {NUMBER} \+- {NUMBER} \| {NUMBER} "
             rf"\+- {NUMBER} \| {NUMBER} \| {NUMBER} \|$",
+            rf"^\| generated/u_channel\.stl \| 44 \| 2 \| {NUMBER} \+- {NUMBER} ",
             rf"^\| meshes/rock\.stl x16 \| 320 \| 1 \| {NUMBER} \|$",
         ),
         ("cover.md", "cover.csv", "cover.png"),

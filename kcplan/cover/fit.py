@@ -514,15 +514,13 @@ def _grow(
         if union < growth.union:
             children = search.children(leaves[k], normal, offset)
         elif len(leaves) + 2 > target or not LOOKAHEAD:
-            growth.note = f"stopped at {len(leaves)} bodies: no cut made the cover smaller"
+            growth.note = _stopped(len(leaves), "no cut made the cover smaller")
             break
         else:
             union, k, normal, offset, children = search.best_pair(leaves)
             if not union < growth.union:
-                growth.note = (
-                    f"stopped at {len(leaves)} bodies: no sequence of two cuts made the "
-                    "cover smaller"
-                )
+                why = "no sequence of two cuts made the cover smaller"
+                growth.note = _stopped(len(leaves), why)
                 break
         leaf = leaves.pop(k)
         leaf.node |= {"plane": [*normal.tolist(), float(offset)]}
@@ -531,6 +529,11 @@ def _grow(
         growth.trail[len(leaves)] = search.union(leaves)
         report(len(leaves))
     return growth
+
+
+def _stopped(count: int, why: str) -> str:
+    """``stopped at 2 bodies: WHY`` (the note of a cover with fewer bodies than asked)."""
+    return f"stopped at {count} bod{'y' if count == 1 else 'ies'}: {why}"
 
 
 def _best_sectors(
