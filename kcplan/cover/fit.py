@@ -6,15 +6,30 @@ is a piece of the part with the smallest ellipsoid that holds the piece's hull p
 then scaled until every point is inside). Starting from the whole part, the fit splits,
 one leaf at a time, the piece whose best cut shrinks the union of the ellipsoids most,
 until there are ``bodies`` leaves, or until the bodies' total volume is within
-``1 + max_excess`` of the part's (the total bounds the union's volume from above), or
-until no cut makes the union smaller.
+``1 + max_excess`` of the part's (the total bounds the union's volume from above).
 
 *Candidate cuts* of a piece are planes across the axes of its ellipsoid and of the part's
-frame, at seven quantiles of the piece's boundary points along each. A candidate is
-scored by the union's volume on a fixed quasi-random sample (the same points for every
-candidate, so comparisons are free of sampling noise), with the children fitted to their
-clipped boundary points only; the chosen children are then fitted to their full hull
-points (cell corners inside the part included), which is what makes the cover sound.
+frame, at seven quantiles of the piece's boundary points along each, and the planes of
+the part's largest planar faces (coplanar triangles grouped, at most eight that cross
+the piece). A candidate is scored by the union's volume on a fixed quasi-random sample
+(the same points for every candidate, so comparisons are free of sampling noise), with
+the children fitted to their clipped boundary points only; the chosen children are then
+fitted to their full hull points (cell corners inside the part included), which is what
+makes the cover sound.
+
+*Beyond one greedy cut.* When no single cut makes the union smaller, the best three cuts
+of each leaf are tried as the first of a *sequence of two* (their children fitted as if
+chosen, then the best single cut of any leaf): a ring's half needs its other half cut
+too before the union shrinks. The fit stops early only when no such sequence helps, and
+says so in :attr:`Cover.note`. The tree is grown twice, once with the candidates above
+and once adding *planes through the axes* of the part's ellipsoid (through its centre,
+every 30 degrees about each axis: a hole's axis is one of them), and the smaller union
+is kept: the extra planes help some parts and mislead the greedy choice on others. A
+third tree starts from the part cut into an even number of *equal sectors* about one of
+those axes (4, 6, ... up to ``bodies``; the best, if its union is smaller than the
+others reached with as many leaves) and is grown from there; a ring or a pipe, whose
+first greedy cut makes two flat rings, is cut into sectors this way. Every tree is a
+tree of planes whose leaves are fitted to their full hull points, so each is sound.
 
 The cover is of the *input's own* surface and solid (no remeshing, no decomposition
 library: an approximate convex decomposition such as CoACD remeshes the input and
