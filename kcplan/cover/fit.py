@@ -280,6 +280,10 @@ class _Scorer:
         return int(inside.sum()) * self.cell + outside
 
 
+class _EmptySector(Exception):
+    """A sector of :meth:`_Search.sectors` holds nothing of the part."""
+
+
 class _Search:
     """What the search needs of a part: its fitted leaves and their candidate cuts."""
 
@@ -292,9 +296,10 @@ class _Search:
         self.axes = ellipsoid_axes(self.root.M)[1]
         self.pencils = _pencils(self.root.center, self.axes) if pencils else None
 
-    def leaf(self, piece: Piece) -> _Leaf:
-        """A leaf of the piece, its ellipsoid fitted to its full hull points."""
-        points = piece.points(self.solid.boundary)
+    def leaf(self, piece: Piece, points: NDArray | None = None) -> _Leaf:
+        """A leaf of the piece, its ellipsoid fitted to its full hull points (``points``,
+        if they are known already)."""
+        points = piece.points(self.solid.boundary) if points is None else points
         c, M = _enclosing(points, self.shape, FINAL_TOL)
         inside = self.scorer.inside(c, M)
         return _Leaf({}, piece, points, c, M, inside, self.scorer.outside(M, inside))
@@ -311,16 +316,20 @@ class _Search:
         inside = np.logical_or.reduce([leaf.inside for leaf in leaves])
         return self.scorer.union(inside, sum(leaf.outside for leaf in leaves))
 
-    def sectors(self, axis: int, m: int) -> tuple[dict, list[_Leaf]]:
+    def sectors(self, axis: int, m: int) -> tuple[dict, list[_Leaf]] | None:
         """The part cut into ``m`` (even) equal sectors about an axis of its ellipsoid by
-        planes through the axis (:func:`_pencil_normal`): a fresh tree and its leaves."""
+        planes through the axis (:func:`_pencil_normal`): a fresh tree and its leaves, or
+        None when a sector holds nothing of the part."""
         R, center = self.axes, self.root.center
 
         def split(node: dict, piece: Piece, low: float, high: float, j: int) -> list[_Leaf]:
             """Sectors ``j`` of the angles ``[low, high]`` (at most a half turn apart, or
             the whole turn at the root) of ``piece``, whose tree node is ``node``."""
             if j == 1:
-                leaf = self.leaf(piece)
+                points = piece.points(self.solid.boundary)
+                if len(points) == 0:
+                    raise _EmptySector
+                leaf = self.leaf(piece, points)
                 leaf.node = node
                 return [leaf]
             angle = low + (high - low) * (j // 2) / j
@@ -332,7 +341,10 @@ class _Search:
             return below + split(node["above"], above, angle, high, j - j // 2)
 
         root: dict = {}
-        return root, split(root, self.root.piece, -np.pi, np.pi, m)
+        try:
+            return root, split(root, self.root.piece, -np.pi, np.pi, m)
+        except _EmptySector:
+            return None
 
     def planes(self, leaf: _Leaf) -> list[tuple[NDArray, float]]:
         """Candidate cuts of a leaf as ``(normal, offset)``: across its ellipsoid's and the
@@ -562,10 +574,12 @@ def _best_sectors(
     for m in range(4, bodies + 1, 2):
         reached = min(u for g in growths for count, u in g.trail.items() if count <= m)
         for axis in range(search.solid.dimension if search.solid.dimension == 3 else 1):
-            root, leaves = search.sectors(axis, m)
-            union = search.union(leaves)
+            sectors = search.sectors(axis, m)
+            if sectors is None:
+                continue
+            union = search.union(sectors[1])
             if union < min(best_union, reached):
-                best, best_union = (root, leaves), union
+                best, best_union = sectors, union
     return best
 
 
