@@ -1,0 +1,75 @@
+"""Forward kinematics of an arm from the joint placements and axes Pinocchio's model gives.
+
+This is the chain the certificates bound (joint origins, axes, the frames between them),
+written out in numpy so that it can be read and bounded term by term; the compiled kernel
+will hold its C++ twin. Both are compared with ``pinocchio.forwardKinematics``
+(``tests/test_arm.py``, to 1e-12 on random configurations).
+
+Conventions: a frame is a 4 x 4 homogeneous matrix ``[[R, t], [0, 1]]`` mapping the
+joint's (or body's) coordinates to the world's; joint ``i`` of the reduced model has the
+frame ``oMi[i] = oMi[parent(i)] @ jointPlacements[i] @ motion_i(q)``, where
+``motion_i`` turns by ``q`` about the joint's axis (revolute) or slides ``q`` along it
+(prismatic), and ``oMi[0]`` (the universe) is the identity.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kcplan.arm.model import JOINT_KINDS, ArmModel
+
+__all__ = ["body_frames", "joint_axes", "joint_frames"]
+
+
+def joint_axes(arm: ArmModel) -> NDArray[np.float64]:
+    """Unit axis of every joint of the reduced model in its own frame, shape
+    ``(njoints, 3)`` (row 0, the universe, is zero)."""
+    model = arm.model
+    axes = np.zeros((model.njoints, 3))
+    for i in range(1, model.njoints):
+        joint = model.joints[i]
+        _, axis = JOINT_KINDS[joint.shortname()]
+        if axis is None:  # an unaligned joint carries its axis
+            axis = np.asarray(joint.extract().axis, dtype=float).ravel()
+        axes[i] = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    return axes
+
+
+def _rotation(axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
+    """Rodrigues' formula: the rotation by ``angle`` about the unit ``axis``."""
+    x, y, z = axis
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+
+
+def joint_frames(arm: ArmModel, state: Sequence[float]) -> NDArray[np.float64]:
+    """World frames of every joint of the reduced model at ``state`` (the group's joint
+    values, :attr:`ArmModel.joints` order), shape ``(njoints, 4, 4)``."""
+    model = arm.model
+    q = arm.configuration(state)
+    axes = joint_axes(arm)
+    frames = np.empty((model.njoints, 4, 4))
+    frames[0] = np.eye(4)
+    for i in range(1, model.njoints):
+        joint = model.joints[i]
+        kind, _ = JOINT_KINDS[joint.shortname()]
+        motion = np.eye(4)
+        value = float(q[joint.idx_q])
+        if kind == "revolute":
+            motion[:3, :3] = _rotation(axes[i], value)
+        else:
+            motion[:3, 3] = value * axes[i]
+        placement = np.asarray(model.jointPlacements[i].homogeneous, dtype=float)
+        frames[i] = frames[model.parents[i]] @ placement @ motion
+    return frames
+
+
+def body_frames(arm: ArmModel, state: Sequence[float]) -> NDArray[np.float64]:
+    """World frames of every covering body at ``state``, shape ``(len(arm.bodies), 4,
+    4)``: body ``k`` is the ellipsoid of semi-axes ``arm.bodies[k].semi_axes`` about the
+    frame's origin along its axes."""
+    frames = joint_frames(arm, state)
+    return np.stack([frames[b.joint] @ b.placement for b in arm.bodies])

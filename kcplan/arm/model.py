@@ -1,0 +1,325 @@
+"""An arm robot from its URDF: the chain, its joint limits and the ellipsoids that cover
+its links, as one immutable description.
+
+Pinocchio reads the URDF (``pinocchio.buildModelFromUrdf``: joints, limits, placements)
+and its collision geometry (``pinocchio.buildGeomFromUrdf``), and removes the SRDF's
+disabled collision pairs (``pinocchio.removeCollisionPairs``). The *planning group* is a
+list of joints in state order; every other joint is locked at a fixed value
+(``pinocchio.buildReducedModel``), so the reduced model's configuration is exactly the
+group's joint vector (``nq`` = number of joints in the group).
+
+Every collision geometry is covered by ellipsoids: a mesh by :mod:`kcplan.cover` (its own
+triangles, a sound cover, cached per user; a mesh that is not closed, such as the Panda's
+link6, by a cover of its convex hull, which holds every triangle), a sphere exactly, a box
+and a cylinder by the smallest ellipsoid through their corners or rims (below). A body's
+frame is given in the frame of the joint that carries it (``placement``, a 4 x 4
+homogeneous matrix: the geometry's placement in the joint frame times the body's pose in
+the geometry's frame), so its world frame at a configuration is ``oMi[joint] @
+placement`` (:func:`kcplan.arm.kinematics.body_frames`).
+
+Enclosing ellipsoids of primitives (each contains the primitive, proof by the extreme
+points): the box of half sizes ``h`` lies in the ellipsoid of semi-axes ``sqrt(3) h``
+(a corner has ``sum (h_i / (sqrt(3) h_i))^2 = 1``, and the box is the hull of its
+corners); the cylinder of radius ``r`` and half height ``c`` lies in the ellipsoid of
+semi-axes ``(sqrt(3/2) r, sqrt(3/2) r, sqrt(3) c)`` (a rim point has ``r^2 / (3/2 r^2) +
+c^2 / (3 c^2) = 2/3 + 1/3 = 1``, and the cylinder is the hull of its two rims).
+
+This module reads files and fits covers; it imports neither OMPL nor FCL.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kcplan.cover.cache import cached_cover
+from kcplan.cover.solid import SolidError
+from kcplan.geometry.pose import quaternion_matrix
+
+__all__ = ["ArmBody", "ArmError", "ArmModel", "JOINT_KINDS", "load_arm"]
+
+JOINT_KINDS = {
+    "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
+    "JointModelRY": ("revolute", (0.0, 1.0, 0.0)),
+    "JointModelRZ": ("revolute", (0.0, 0.0, 1.0)),
+    "JointModelRevoluteUnaligned": ("revolute", None),
+    "JointModelPX": ("prismatic", (1.0, 0.0, 0.0)),
+    "JointModelPY": ("prismatic", (0.0, 1.0, 0.0)),
+    "JointModelPZ": ("prismatic", (0.0, 0.0, 1.0)),
+    "JointModelPrismaticUnaligned": ("prismatic", None),
+}
+"""Pinocchio joint models a planning group may hold: ``(kind, axis)`` with the axis in
+the joint's frame (None: read from the joint model). A continuous joint (Pinocchio's
+``JointModelRUB*``, two configuration numbers cos and sin) is refused: its angle has no
+limits for a joint-space box."""
+
+
+class ArmError(ValueError):
+    """An arm that cannot be built; ``str(err)`` is ``FILE: FIELD: expected ..., got ...``."""
+
+
+@dataclass(frozen=True, eq=False)
+class ArmBody:
+    """One covering ellipsoid of a link.
+
+    Attributes
+    ----------
+    link : str
+        The URDF link whose collision geometry it covers.
+    geometry : int
+        Index of that geometry in :attr:`ArmModel.geometry`.
+    joint : int
+        Index, in the reduced model, of the joint that carries the link (0: the universe,
+        a body that never moves).
+    placement : ndarray, shape (4, 4)
+        The body's frame in the joint's frame (its centre and axes).
+    semi_axes : ndarray, shape (3,)
+        Along the body frame's x, y, z, in metres.
+    """
+
+    link: str
+    geometry: int
+    joint: int
+    placement: NDArray[np.float64]
+    semi_axes: NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class ArmModel:
+    """An arm: the reduced chain of its planning group and the bodies covering its links
+    (see the module docstring). Build it with :func:`load_arm`.
+
+    Attributes
+    ----------
+    model : pinocchio.Model
+        The chain with every joint outside the group locked; ``model.nq == len(joints)``.
+    geometry : pinocchio.GeometryModel
+        The links' collision geometry on ``model``, with the collision pairs left after
+        the SRDF's disabled pairs were removed.
+    joints : tuple of str
+        The planning group, in state order.
+    q_index : ndarray of int, shape (len(joints),)
+        Where each joint of the state sits in ``model``'s configuration vector.
+    lower, upper : ndarray, shape (len(joints),)
+        Joint limits (radians, or metres for a prismatic joint), from the URDF.
+    kinds : tuple of str
+        ``revolute`` or ``prismatic``, per joint of the group.
+    bodies : tuple of ArmBody
+        Every covering ellipsoid.
+    self_pairs : ndarray of int, shape (m, 2)
+        Pairs of body indices ``(i, j)``, ``i < j``, that may collide with each other: their
+        geometries form a collision pair of :attr:`geometry`.
+    urdf, srdf : str
+        The files read (``srdf`` empty when none was given).
+    """
+
+    model: object
+    geometry: object
+    joints: tuple[str, ...]
+    q_index: NDArray[np.int64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    kinds: tuple[str, ...]
+    bodies: tuple[ArmBody, ...]
+    self_pairs: NDArray[np.int64]
+    urdf: str
+    srdf: str = ""
+
+    @property
+    def dof(self) -> int:
+        """Number of joints in the planning group (the state's length)."""
+        return len(self.joints)
+
+    def configuration(self, state: Sequence[float]) -> NDArray[np.float64]:
+        """The reduced model's configuration vector of a state ``(dof,)`` (joint values in
+        :attr:`joints` order)."""
+        state = np.asarray(state, dtype=float)
+        if state.shape != (self.dof,):
+            raise ValueError(f"state: expected {self.dof} joint values, got shape {state.shape}")
+        q = np.zeros(self.dof)
+        q[self.q_index] = state
+        return q
+
+    def within_limits(self, q: Sequence[float]) -> bool:
+        """Whether ``q`` (shape ``(dof,)``) is finite and inside the joint limits."""
+        q = np.asarray(q, dtype=float)
+        return bool(
+            q.shape == (self.dof,)
+            and np.isfinite(q).all()
+            and (q >= self.lower).all()
+            and (q <= self.upper).all()
+        )
+
+
+def load_arm(
+    urdf: str | os.PathLike,
+    joints: Sequence[str],
+    srdf: str | os.PathLike | None = None,
+    fixed: Mapping[str, float] | None = None,
+    bodies_per_link: int = 1,
+    package_dirs: Sequence[str | os.PathLike] | None = None,
+) -> ArmModel:
+    """Read an arm from its URDF (and SRDF) and cover its links by ellipsoids.
+
+    Parameters
+    ----------
+    urdf : path-like
+        The robot's URDF; mesh paths ``package://...`` resolve against ``package_dirs``
+        (default: the URDF's folder).
+    joints : sequence of str
+        The planning group, in state order: revolute or prismatic joints of the URDF,
+        each named once.
+    srdf : path-like, optional
+        Its ``disable_collisions`` pairs are never checked for self-collision.
+    fixed : mapping of str to float, optional
+        Values of joints outside the group (default 0, or the nearest limit when 0 lies
+        outside them).
+    bodies_per_link : int
+        Ellipsoids per mesh geometry (:func:`kcplan.cover.cache.cached_cover`).
+    package_dirs : sequence of path-like, optional
+
+    Raises
+    ------
+    ArmError
+        One line naming the file, the field and what is expected.
+    """
+    import pinocchio as pin  # imported here: the rigid planners never need it
+
+    source = os.fspath(urdf)
+    if not Path(source).is_file():
+        raise ArmError(f"{source}: urdf: expected a URDF file, found none")
+    dirs = [os.fspath(d) for d in (package_dirs or [Path(source).parent])]
+    try:
+        full = pin.buildModelFromUrdf(source)
+        full_geometry = pin.buildGeomFromUrdf(
+            full, source, pin.GeometryType.COLLISION, package_dirs=dirs
+        )
+    except (RuntimeError, ValueError, OSError) as err:
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ArmError(f"{source}: urdf: expected a readable URDF, got: {first}") from None
+    group = _group(full, joints, source)
+    fixed = dict(fixed or {})
+    q_fixed = pin.neutral(full)
+    for name, value in fixed.items():
+        if not full.existJointName(name):
+            raise ArmError(f"{source}: fixed: {name!r} is not a joint of the URDF")
+        if name in group:
+            raise ArmError(f"{source}: fixed: {name!r} is in the planning group")
+        joint = full.joints[full.getJointId(name)]
+        if joint.nq != 1 or not math.isfinite(float(value)):
+            raise ArmError(f"{source}: fixed.{name}: expected a finite value of a 1-DOF joint")
+        q_fixed[joint.idx_q] = float(value)
+    for name in full.names[1:]:
+        joint = full.joints[full.getJointId(name)]
+        if name not in group and name not in fixed and joint.nq == 1:
+            low, high = full.lowerPositionLimit[joint.idx_q], full.upperPositionLimit[joint.idx_q]
+            q_fixed[joint.idx_q] = min(max(0.0, low), high)
+    locked = [full.getJointId(n) for n in full.names[1:] if n not in group]
+    full_geometry.addAllCollisionPairs()
+    if srdf is not None:
+        if not Path(srdf).is_file():
+            raise ArmError(f"{os.fspath(srdf)}: srdf: expected an SRDF file, found none")
+        try:
+            pin.removeCollisionPairs(full, full_geometry, os.fspath(srdf))
+        except (RuntimeError, ValueError) as err:
+            raise ArmError(
+                f"{os.fspath(srdf)}: srdf: expected a readable SRDF, got: {err}"
+            ) from None
+    model, geometry = pin.buildReducedModel(full, full_geometry, locked, q_fixed)
+    if len(geometry.geometryObjects) == 0:
+        raise ArmError(f"{source}: collision: expected links with collision geometry, got none")
+    ids = [model.getJointId(n) for n in group]
+    kinds = tuple(JOINT_KINDS[model.joints[i].shortname()][0] for i in ids)
+    q_index = np.array([model.joints[i].idx_q for i in ids], dtype=np.int64)
+    lower, upper = model.lowerPositionLimit[q_index], model.upperPositionLimit[q_index]
+    if not (np.isfinite(lower).all() and np.isfinite(upper).all() and (lower <= upper).all()):
+        raise ArmError(f"{source}: limits: expected finite joint limits, got {lower} to {upper}")
+    bodies = []
+    for index, obj in enumerate(geometry.geometryObjects):
+        placement = np.asarray(obj.placement.homogeneous, dtype=float)
+        link = model.frames[obj.parentFrame].name
+        for frame, semi_axes in _cover(obj, bodies_per_link, source):
+            bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
+    self_pairs = _self_pairs(geometry, bodies)
+    return ArmModel(
+        model, geometry, tuple(group), q_index, np.array(lower), np.array(upper), kinds,
+        tuple(bodies), self_pairs, source, "" if srdf is None else os.fspath(srdf),
+    )  # fmt: skip
+
+
+def _group(full, joints: Sequence[str], source: str) -> list[str]:
+    """The planning group's names, checked against the URDF."""
+    group = list(joints)
+    if not group:
+        raise ArmError(f"{source}: joints: expected at least one joint of the URDF, got none")
+    for name in group:
+        if not isinstance(name, str) or not full.existJointName(name):
+            known = ", ".join(full.names[1:])
+            raise ArmError(f"{source}: joints: {name!r} is not a joint of the URDF ({known})")
+        if group.count(name) > 1:
+            raise ArmError(f"{source}: joints: {name!r} is named twice")
+        shortname = full.joints[full.getJointId(name)].shortname()
+        if shortname not in JOINT_KINDS:
+            raise ArmError(
+                f"{source}: joints: {name!r} is a {shortname}; expected a revolute or "
+                "prismatic joint with limits"
+            )
+    return group
+
+
+def _cover(obj, bodies: int, source: str) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """``(frame, semi_axes)`` of the ellipsoids covering one geometry, frames ``(4, 4)`` in
+    the geometry's frame (see the module docstring for the primitives)."""
+    shape = obj.geometry
+    kind = type(shape).__name__
+    eye = np.eye(4)
+    if kind == "Sphere":
+        return [(eye, np.full(3, float(shape.radius)))]
+    if kind == "Box":
+        return [(eye, math.sqrt(3.0) * np.asarray(shape.halfSide, dtype=float))]
+    if kind == "Cylinder":
+        r, c = float(shape.radius), float(shape.halfLength)
+        return [(eye, np.array([math.sqrt(1.5) * r, math.sqrt(1.5) * r, math.sqrt(3.0) * c]))]
+    if not obj.meshPath:
+        raise ArmError(
+            f"{source}: collision: {obj.name}: expected a mesh, box, cylinder or sphere, got {kind}"
+        )
+    scale = np.asarray(obj.meshScale, dtype=float)
+    if not np.allclose(scale, scale[0]):
+        raise ArmError(
+            f"{source}: collision: {obj.name}: expected a uniform mesh scale, got {scale.tolist()}"
+        )
+    try:
+        cover, _ = cached_cover(obj.meshPath, bodies, scale=float(scale[0]))
+    except SolidError as err:
+        # a collision mesh that is not closed is a surface: its convex hull holds it
+        try:
+            cover, _ = cached_cover(obj.meshPath, bodies, scale=float(scale[0]), hull=True)
+        except SolidError:
+            raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
+    out = []
+    for body in cover.bodies:
+        frame = np.eye(4)
+        frame[:3, :3] = quaternion_matrix(body.pose[3:])
+        frame[:3, 3] = body.pose[:3]
+        out.append((frame, np.asarray(body.semi_axes, dtype=float)))
+    return out
+
+
+def _self_pairs(geometry, bodies: list[ArmBody]) -> NDArray[np.int64]:
+    """Body pairs whose geometries form a collision pair of ``geometry``."""
+    by_geometry: dict[int, list[int]] = {}
+    for k, body in enumerate(bodies):
+        by_geometry.setdefault(body.geometry, []).append(k)
+    pairs = []
+    for pair in geometry.collisionPairs:
+        for i in by_geometry.get(pair.first, []):
+            for j in by_geometry.get(pair.second, []):
+                pairs.append((min(i, j), max(i, j)))
+    return np.array(sorted(set(pairs)), dtype=np.int64).reshape(-1, 2)

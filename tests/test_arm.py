@@ -1,0 +1,179 @@
+"""Arm robots from URDF (kcplan.arm): the chain, its limits and its link covers."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import trimesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from kcplan.arm import ArmError, body_frames, joint_frames, load_arm
+
+ROOT = Path(__file__).resolve().parents[1]
+PANDA = ROOT / "scenarios" / "arm" / "panda"
+GROUP = [f"panda_joint{i}" for i in range(1, 8)]
+
+
+@pytest.fixture(scope="module")
+def panda(tmp_path_factory):
+    cache = tmp_path_factory.mktemp("covers")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("KCPLAN_CACHE_DIR", str(cache))
+        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf")
+
+
+def test_the_panda_group_its_limits_and_its_bodies(panda):
+    assert panda.dof == 7 and panda.joints == tuple(GROUP)
+    assert panda.kinds == ("revolute",) * 7
+    # the URDF's limits, radians
+    assert panda.lower[3] == pytest.approx(-3.1416) and panda.upper[5] == pytest.approx(3.8223)
+    links = [b.link for b in panda.bodies]
+    assert links == [f"panda_link{i}" for i in range(8)] + [
+        "panda_hand", "panda_leftfinger", "panda_rightfinger",
+    ]  # fmt: skip
+    assert [b.joint for b in panda.bodies] == [0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7]
+    # the SRDF disables 28 of the 49 pairs Pinocchio would check
+    assert len(panda.self_pairs) == 21 and (panda.self_pairs[:, 0] < panda.self_pairs[:, 1]).all()
+    hand = links.index("panda_hand")
+    assert not ((panda.self_pairs == [links.index("panda_link7"), hand]).all(axis=1)).any()
+    assert panda.within_limits(np.zeros(7))
+    assert not panda.within_limits([0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.0])  # joint 4 <= 0.0873
+    assert not panda.within_limits([math.nan] * 7) and not panda.within_limits(np.zeros(6))
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(u=st.lists(st.floats(0.0, 1.0), min_size=7, max_size=7))
+def test_joint_frames_agree_with_pinocchio(panda, u):
+    """The numpy chain (joint placements and axes) against pinocchio.forwardKinematics,
+    every joint frame to 1e-12, anywhere in the limits."""
+    state = panda.lower + np.asarray(u) * (panda.upper - panda.lower)
+    data = panda.model.createData()
+    pin.forwardKinematics(panda.model, data, panda.configuration(state))
+    frames = joint_frames(panda, state)
+    for i in range(panda.model.njoints):
+        assert np.abs(frames[i] - data.oMi[i].homogeneous).max() < 1e-12
+
+
+def test_every_mesh_vertex_lies_in_its_links_bodies(panda):
+    """At random configurations, every vertex of every link's collision mesh, placed by
+    Pinocchio's geometry placements, lies inside the union of that link's bodies placed by
+    body_frames: the chain and the covers together are sound."""
+    rng = np.random.default_rng(7)
+    data, gdata = panda.model.createData(), panda.geometry.createData()
+    vertices = {}
+    for g, obj in enumerate(panda.geometry.geometryObjects):
+        mesh = trimesh.load(obj.meshPath, force="mesh", process=False)
+        vertices[g] = np.asarray(mesh.vertices) * np.asarray(obj.meshScale)
+    for _ in range(5):
+        state = rng.uniform(panda.lower, panda.upper)
+        pin.forwardKinematics(panda.model, data, panda.configuration(state))
+        pin.updateGeometryPlacements(panda.model, data, panda.geometry, gdata)
+        frames = body_frames(panda, state)
+        for g, V in vertices.items():
+            oMg = gdata.oMg[g].homogeneous
+            world = V @ oMg[:3, :3].T + oMg[:3, 3]
+            worst = np.full(len(world), np.inf)
+            for body, frame in zip(panda.bodies, frames, strict=True):
+                if body.geometry != g:
+                    continue
+                local = (world - frame[:3, 3]) @ frame[:3, :3]
+                worst = np.minimum(worst, ((local / body.semi_axes) ** 2).sum(axis=1))
+            assert worst.max() <= 1.0 + 1e-9, (panda.geometry.geometryObjects[g].name, worst.max())
+
+
+def test_a_group_in_another_order_is_the_state_order(tmp_path, monkeypatch):
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
+    arm = load_arm(PANDA / "panda.urdf", ["panda_joint2", "panda_joint1"])
+    assert arm.joints == ("panda_joint2", "panda_joint1") and arm.dof == 2
+    assert arm.lower.tolist() == pytest.approx([-1.8326, -2.9671])
+    frames = joint_frames(arm, [0.3, -0.2])
+    data = arm.model.createData()
+    pin.forwardKinematics(arm.model, data, arm.configuration([0.3, -0.2]))
+    assert np.allclose(frames[1], data.oMi[1].homogeneous, atol=1e-12)
+    # joint 1 (state index 1) turns about the base's z axis by -0.2
+    assert math.atan2(frames[1][1, 0], frames[1][0, 0]) == pytest.approx(-0.2)
+
+
+@pytest.mark.parametrize(
+    "joints, kwargs, message",
+    [
+        ([], {}, r"joints: expected at least one joint of the URDF, got none"),
+        (["panda_joint1", "nope"], {}, r"joints: 'nope' is not a joint of the URDF"),
+        (["panda_joint1", "panda_joint1"], {}, r"joints: 'panda_joint1' is named twice"),
+        (
+            GROUP,
+            {"fixed": {"panda_joint1": 0.1}},
+            r"fixed: 'panda_joint1' is in the planning group",
+        ),
+        (GROUP[:6], {"fixed": {"nope": 0.1}}, r"fixed: 'nope' is not a joint of the URDF"),
+        (
+            GROUP[:6],
+            {"fixed": {"panda_joint7": math.inf}},
+            r"fixed.panda_joint7: expected a finite",
+        ),
+        (GROUP, {"srdf": "missing.srdf"}, r"missing.srdf: srdf: expected an SRDF file, found none"),
+    ],
+)
+def test_bad_groups_are_refused_with_one_line(joints, kwargs, message):
+    with pytest.raises(ArmError, match=message) as err:
+        load_arm(PANDA / "panda.urdf", joints, **kwargs)
+    assert "\n" not in str(err.value)
+
+
+def test_unreadable_robots_are_refused_with_one_line(tmp_path):
+    with pytest.raises(ArmError, match=r"urdf: expected a URDF file, found none"):
+        load_arm(tmp_path / "none.urdf", GROUP)
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'/><joint")
+    with pytest.raises(ArmError, match=r"bad.urdf: urdf: expected a readable URDF"):
+        load_arm(bad, GROUP)
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(
+        "<robot name='x'><link name='a'/><link name='b'/>"
+        "<joint name='j' type='revolute'><parent link='a'/><child link='b'/>"
+        "<axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+        "</robot>"
+    )
+    with pytest.raises(ArmError, match=r"bare.urdf: collision: expected links with collision"):
+        load_arm(bare, ["j"])
+
+
+def test_primitives_are_covered_by_their_enclosing_ellipsoids(tmp_path):
+    """A box, a cylinder and a sphere link: every extreme point (corners, rim points, the
+    sphere's poles) is inside its one body, and the box's corners and the cylinder's rim
+    lie on it (the bounds of the module docstring are tight)."""
+    urdf = tmp_path / "prims.urdf"
+    links = {
+        "box": "<box size='0.2 0.4 0.6'/>",
+        "can": "<cylinder radius='0.1' length='0.5'/>",
+        "ball": "<sphere radius='0.15'/>",
+    }
+    parts = ["<robot name='p'><link name='base'/>"]
+    for k, (name, shape) in enumerate(links.items()):
+        parts.append(
+            f"<link name='{name}'><collision><origin xyz='0 0 {0.1 * k}'/><geometry>{shape}"
+            "</geometry></collision></link>"
+            f"<joint name='j_{name}' type='revolute'><parent link='base'/><child link='{name}'/>"
+            "<axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+        )
+    urdf.write_text("".join(parts) + "</robot>")
+    arm = load_arm(urdf, [f"j_{n}" for n in links])
+    assert sorted(b.link for b in arm.bodies) == sorted(links)  # Pinocchio's order
+    box, can, ball = (next(b for b in arm.bodies if b.link == name) for name in links)
+    assert box.semi_axes == pytest.approx(math.sqrt(3) * np.array([0.1, 0.2, 0.3]))
+    assert can.semi_axes == pytest.approx([math.sqrt(1.5) * 0.1] * 2 + [math.sqrt(3) * 0.25])
+    assert ball.semi_axes == pytest.approx([0.15] * 3)
+    corners = np.array([[x, y, z] for x in (-0.1, 0.1) for y in (-0.2, 0.2) for z in (-0.3, 0.3)])
+    angles = np.linspace(0, 2 * math.pi, 16)
+    rim = np.array(
+        [[0.1 * math.cos(a), 0.1 * math.sin(a), z] for a in angles for z in (-0.25, 0.25)]
+    )
+    for body, points in ((box, corners), (can, rim)):
+        assert ((points / body.semi_axes) ** 2).sum(axis=1) == pytest.approx(1.0)
+    assert box.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.0])
+    assert ball.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.2])
