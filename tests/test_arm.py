@@ -10,7 +10,15 @@ import trimesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from kcplan.arm import ArmError, body_frames, joint_frames, load_arm
+from kcplan.arm import (
+    ArmError,
+    body_frames,
+    carries,
+    joint_frames,
+    load_arm,
+    pair_speeds,
+    speeds,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "scenarios" / "arm" / "panda"
@@ -177,3 +185,73 @@ def test_primitives_are_covered_by_their_enclosing_ellipsoids(tmp_path):
         assert ((points / body.semi_axes) ** 2).sum(axis=1) == pytest.approx(1.0)
     assert box.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.0])
     assert ball.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.2])
+
+
+def _surface_points(arm, frames, count=24, seed=0):
+    """Points on every body's surface at the given body frames, shape (bodies, count, 3)."""
+    u = np.random.default_rng(seed).normal(size=(count, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    local = u[None] * np.stack([b.semi_axes for b in arm.bodies])[:, None]
+    return np.einsum("kij,knj->kni", frames[:, :3, :3], local) + frames[:, None, :3, 3]
+
+
+def _check_speeds(arm, q1, q2, steps=65):
+    """Every sampled surface point moves at most speed * s from q(0), and every distance
+    between points of a self pair changes by at most pair speed * s."""
+    s = np.linspace(0.0, 1.0, steps)
+    paths = np.stack([_surface_points(arm, body_frames(arm, q1 + t * (q2 - q1))) for t in s])
+    moved = np.linalg.norm(paths - paths[0], axis=-1).max(axis=-1)  # (steps, bodies)
+    bound = speeds(arm, q1, q2)
+    assert (moved <= s[:, None] * bound[None] + 1e-12).all()
+    pairs = arm.self_pairs
+    if len(pairs):
+        first, second = pairs[:, 0], pairs[:, 1]
+        gaps = np.linalg.norm(paths[:, first, :, None] - paths[:, second, None, :], axis=-1)
+        change = np.abs(gaps - gaps[0]).max(axis=(-1, -2))  # (steps, pairs)
+        assert (change <= s[:, None] * pair_speeds(arm, q1, q2, pairs)[None] + 1e-12).all()
+    return moved[-1], bound
+
+
+def test_the_chain_bounds_every_points_motion_along_random_edges(panda):
+    """The speed bounds of kcplan.arm.bounds against the motion of surface points sampled
+    at 65 points of random edges (long and short): sound, and a joint moves only the
+    bodies it carries."""
+    rng = np.random.default_rng(3)
+    for scale in (1.0, 0.1, 0.01):
+        for _ in range(4):
+            q1 = rng.uniform(panda.lower, panda.upper)
+            q2 = np.clip(q1 + scale * rng.uniform(-6, 6, 7), panda.lower, panda.upper)
+            moved, bound = _check_speeds(panda, q1, q2)
+            assert bound[0] == 0.0 and moved[0] == pytest.approx(0.0, abs=1e-12)  # link0
+    q1 = 0.5 * (panda.lower + panda.upper)
+    q2 = q1.copy()
+    q2[6] += 0.5  # joint 7 carries link7, the hand and the fingers only
+    moving = speeds(panda, q1, q2) > 0
+    assert [b.link for b, m in zip(panda.bodies, moving, strict=True) if m] == [
+        "panda_link7", "panda_hand", "panda_leftfinger", "panda_rightfinger",
+    ]  # fmt: skip
+    assert carries(panda)[:, 0].tolist() == [False] + [True] * 10
+
+
+def test_the_chain_bounds_a_prismatic_joint(tmp_path):
+    """A slide along x carrying a revolute elbow with a box link: sound on random edges,
+    and the slide alone moves every point exactly as far as it slides."""
+    urdf = tmp_path / "slide.urdf"
+    urdf.write_text(
+        "<robot name='s'><link name='base'/><link name='carriage'><collision><geometry>"
+        "<box size='0.2 0.2 0.2'/></geometry></collision></link><link name='arm'><collision>"
+        "<origin xyz='0.5 0 0'/><geometry><box size='1 0.1 0.1'/></geometry></collision></link>"
+        "<joint name='slide' type='prismatic'><parent link='base'/><child link='carriage'/>"
+        "<origin xyz='0 0 0.3'/><axis xyz='1 0 0'/>"
+        "<limit lower='-0.5' upper='2' effort='1' velocity='1'/></joint>"
+        "<joint name='elbow' type='revolute'><parent link='carriage'/><child link='arm'/>"
+        "<origin xyz='0 0.2 0'/><axis xyz='0 0 1'/>"
+        "<limit lower='-2' upper='2' effort='1' velocity='1'/></joint></robot>"
+    )
+    arm = load_arm(urdf, ["slide", "elbow"])
+    assert arm.kinds == ("prismatic", "revolute") and len(arm.self_pairs) == 1
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        _check_speeds(arm, rng.uniform(arm.lower, arm.upper), rng.uniform(arm.lower, arm.upper))
+    moved, bound = _check_speeds(arm, np.array([0.0, 0.3]), np.array([1.5, 0.3]))
+    assert moved == pytest.approx([1.5, 1.5]) and bound == pytest.approx([1.5, 1.5])

@@ -1,9 +1,11 @@
 """Arm robots: a URDF's chain (read by Pinocchio) with its links covered by ellipsoids.
 
 :func:`load_arm` builds an :class:`ArmModel` (the immutable description);
-:mod:`kcplan.arm.kinematics` computes joint and body frames from it.
+:mod:`kcplan.arm.kinematics` computes joint and body frames from it, and
+:mod:`kcplan.arm.bounds` bounds how far its bodies move along a joint-space edge.
 """
 
+from kcplan.arm.bounds import carries, pair_speeds, point_speeds, speeds
 from kcplan.arm.kinematics import body_frames, joint_axes, joint_frames
 from kcplan.arm.model import ArmBody, ArmError, ArmModel, load_arm
 
@@ -12,7 +14,11 @@ __all__ = [
     "ArmError",
     "ArmModel",
     "body_frames",
+    "carries",
     "joint_axes",
     "joint_frames",
     "load_arm",
+    "pair_speeds",
+    "point_speeds",
+    "speeds",
 ]

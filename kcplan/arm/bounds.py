@@ -1,0 +1,113 @@
+"""How far a point of a link can move along a joint-space edge: the chain's bounds.
+
+For the straight edge ``q(s) = q1 + s (q2 - q1)``, ``s`` in ``[0, 1]``, a point ``x`` fixed
+to body ``k`` moves with the velocity (Schwarzer, Saha and Latombe, T-RO 21(3), 2005,
+Sec. III)
+
+    dx/ds = sum_j dq_j (w_j x (x - o_j))   (revolute joint j: unit axis w_j through o_j)
+          + sum_j dq_j w_j                  (prismatic joint j: unit axis w_j)
+
+over the joints ``j`` of the group that carry body ``k`` (those on the path from the root
+to the body's joint), with ``dq = q2 - q1``. ``|w_j x (x - o_j)|`` is the distance of ``x``
+from joint ``j``'s axis, at most ``|x - o_j|``. So if ``rho[k, j]`` bounds ``|x - o_j|`` for
+every point of body ``k`` and every configuration in the joint limits (and ``rho[k, j] =
+1`` for a prismatic joint), integrating over ``[a, b]`` gives
+
+    |x(b) - x(a)| <= (b - a) * sum_j |dq_j| rho[k, j]          (the body's *speed* bound)
+
+``rho`` is configuration-independent: from joint ``j`` to body ``k`` the chain passes the
+joint origins ``o_j = o_{i0}, o_{i1}, ..., o_{im}`` (``m`` joints down to the body's own
+joint ``i_m``), and by the triangle inequality
+
+    |x - o_j| <= sum_{l=1..m} |o_{il} - o_{i(l-1)}| + |c_k| + a_max,k
+
+where ``|o_i - o_parent(i)|`` is the length of joint ``i``'s placement in its parent's
+frame (Pinocchio: ``oMi = oMparent * jointPlacement_i * motion_i(q_i)``), plus, for a
+prismatic joint ``i``, its largest slide ``max(|lower_i|, |upper_i|)``; ``c_k`` is the
+body's centre in its joint's frame and ``a_max,k`` its largest semi-axis.
+
+*Relative* motion of two bodies (self-collision): the joints that carry both bodies move
+them as one rigid body, which changes no distance between them, so only the joints that
+carry exactly one of the two count:
+
+    |d(x_k - x_l)/ds| <= sum_{j carries k only} |dq_j| rho[k, j]
+                         + sum_{j carries l only} |dq_j| rho[l, j].
+
+These are the bounds of the clearance-ball certificate for arms (a body whose clearance
+at ``q(m)`` exceeds its speed bound times ``|s - m|`` stays free on that stretch).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kcplan.arm.model import ArmModel
+
+__all__ = ["carries", "pair_speeds", "point_speeds", "speeds"]
+
+
+def carries(arm: ArmModel) -> NDArray[np.bool_]:
+    """``C[k, j]``: joint ``j`` of the group (state order) carries body ``k``, shape
+    ``(len(arm.bodies), arm.dof)``."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    out = np.zeros((len(arm.bodies), arm.dof), dtype=bool)
+    for k, body in enumerate(arm.bodies):
+        i = body.joint
+        while i > 0:
+            if i in state_of:
+                out[k, state_of[i]] = True
+            i = int(model.parents[i])
+    return out
+
+
+def point_speeds(arm: ArmModel) -> NDArray[np.float64]:
+    """``rho[k, j]``: how far a point of body ``k`` moves per unit of joint ``j``'s motion
+    (metres per radian, or 1 for a prismatic joint; 0 where ``j`` does not carry ``k``),
+    for every configuration in the limits; shape ``(len(arm.bodies), arm.dof)``. See the
+    module docstring for the proof."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    # how far joint i's origin lies from its parent's, over the whole joint box
+    hop = np.zeros(model.njoints)
+    for i in range(1, model.njoints):
+        hop[i] = float(np.linalg.norm(model.jointPlacements[i].translation))
+        j = state_of.get(i)
+        if j is not None and arm.kinds[j] == "prismatic":
+            hop[i] += max(abs(arm.lower[j]), abs(arm.upper[j]))
+    rho = np.zeros((len(arm.bodies), arm.dof))
+    for k, body in enumerate(arm.bodies):
+        reach = float(np.linalg.norm(body.placement[:3, 3]) + body.semi_axes.max())
+        i = body.joint
+        while i > 0:  # walking up: reach is the bound on |x - o_i|
+            if i in state_of:
+                j = state_of[i]
+                rho[k, j] = 1.0 if arm.kinds[j] == "prismatic" else reach
+            reach += hop[i]
+            i = int(model.parents[i])
+    return rho
+
+
+def speeds(arm: ArmModel, q1: Sequence[float], q2: Sequence[float]) -> NDArray[np.float64]:
+    """Bound on how far any point of each body moves over the whole edge ``q1 -> q2``
+    (per unit of the edge parameter ``s``), shape ``(len(arm.bodies),)``, metres."""
+    dq = np.abs(np.asarray(q2, dtype=float) - np.asarray(q1, dtype=float))
+    return point_speeds(arm) @ dq
+
+
+def pair_speeds(
+    arm: ArmModel, q1: Sequence[float], q2: Sequence[float], pairs: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """Bound on how fast the points of body ``k`` and body ``l`` move *relative to each
+    other* along ``q1 -> q2`` for every pair ``(k, l)`` of ``pairs`` (shape ``(m, 2)``):
+    only the joints that carry one of the two count. Shape ``(m,)``, metres per unit of
+    ``s``."""
+    dq = np.abs(np.asarray(q2, dtype=float) - np.asarray(q1, dtype=float))
+    rho, C = point_speeds(arm), carries(arm)
+    first, second = pairs[:, 0], pairs[:, 1]
+    only_first = C[first] & ~C[second]
+    only_second = C[second] & ~C[first]
+    return (rho[first] * only_first) @ dq + (rho[second] * only_second) @ dq
