@@ -32,6 +32,8 @@ from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.planning.certifier import (
     CERTIFICATE_SETS,
     COUNTER_NAMES,
+    PROBE_EVERY,
+    PROBE_WARMUP,
     EdgeCertifier,
     probe_points,
 )
@@ -216,6 +218,9 @@ def _edges(name: str) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
 
 LOOSE_COUNTERS = (
     "rejected_guard",
+    "rejected_probe",
+    "probes",
+    "probed_edges",
     "not_proven",
     "occupancy_queries",
     "certified_by_endpoints",
@@ -230,7 +235,9 @@ different nearest points (so separating planes) and clearances, so a guard reach
 little further in one of them; near contact a guard has a tiny clearance in one and none
 in the other (``not_proven`` / ``rejected_guard``), and coal's collision test reports
 contact up to about 1e-6 before its distance reaches 0, so the kernel learns more grid
-cells from the near-contact states (``occupancy_queries``)."""
+cells from the near-contact states (``occupancy_queries``). A near-contact edge may be
+rejected by a probe in one and by a guard in the other, and the probes' schedule follows
+the rejections (``rejected_probe``, ``probes``, ``probed_edges``)."""
 
 
 def _counter_gap(python: dict, kernel: dict) -> dict:
@@ -699,6 +706,28 @@ def test_a_colliding_probe_rejects_before_any_guard(backend):
     assert c["rejected_guard"] + c["not_proven"] == 1
     with pytest.raises(ValueError, match="probes"):
         _turn_past_a_pin(backend, probes=-1)
+
+
+def test_probes_stop_where_they_do_not_reject():
+    """The schedule (PROBE_WARMUP, PROBE_ODDS, PROBE_EVERY): where no probe rejects, the
+    first PROBE_WARMUP edges that reach the probes are probed, then every PROBE_EVERY-th;
+    both twins keep the same schedule."""
+    counters = []
+    for backend in ("kernel", "python"):
+        world, certifier = _turn_past_a_pin(backend, probes=3)
+        rng = np.random.default_rng(4)
+        for _ in range(1500):
+            p1 = [*rng.uniform(2.5, 3.5, 2), rng.uniform(-3, 3)]  # far from the pin
+            p2 = [*rng.uniform(2.5, 3.5, 2), rng.uniform(-3, 3)]
+            certifier.check(p1, p2)
+        counters.append(certifier.counters)
+    kernel, python = counters
+    for c in counters:
+        assert c["rejected_probe"] == 0 and c["probes"] == 3 * c["probed_edges"]
+        # no edge is decided before the probes (no cached guard, nothing rejected)
+        assert c["cached_guards"] == 0 and c["rejected"] == 0
+        assert c["probed_edges"] == PROBE_WARMUP + (c["edges"] - PROBE_WARMUP) // PROBE_EVERY
+    assert kernel == python
 
 
 def test_probe_points_halve_the_largest_stretch_left():

@@ -58,6 +58,7 @@ nb::dict certifier_counters(const kcplan::CertifierCounters& c) {
   KC_COUNTER(guards); KC_COUNTER(endpoint_guards); KC_COUNTER(cached_guards);
   KC_COUNTER(bisection_nodes); KC_COUNTER(collision_queries); KC_COUNTER(occupancy_rejections);
   KC_COUNTER(occupancy_queries); KC_COUNTER(probes);
+  KC_COUNTER(probed_edges);
 #undef KC_COUNTER
   return d;
 }

@@ -145,7 +145,7 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
     if (world_.sweep_core_collides(edge.pose(lo).t, edge.pose(hi).t, core_radius_))
       return reject(c.rejected_sweep);
   }
-  if (!probe(edge, lo, hi)) return reject(c.rejected_probe);
+  if (probing() && !probe(edge, lo, hi)) return reject(c.rejected_probe);
   if (!g1) {
     g1 = endpoint(p1, k1);
     if (g1->clearance <= 0.0) return reject(c.rejected_guard);
@@ -164,7 +164,18 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
   return advance(edge, lo, hi);
 }
 
+bool EdgeCertifier::probing() {
+  // a probe costs a collision query on every edge it does not reject; it pays where
+  // edges that reach the guards are often rejected (a guard costs several queries)
+  if (probes_ == 0) return false;
+  const CertifierCounters& c = counters;
+  if (c.probed_edges < kProbeWarmup || c.rejected_probe * kProbeOdds >= c.probed_edges)
+    return true;
+  return ++probe_skips_ % kProbeEvery == 0;
+}
+
 bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {
+  ++counters.probed_edges;
   // the van der Corput points 1/2, 1/4, 3/4, 1/8, 5/8, 3/8, ...: each probe halves the
   // largest stretch left unprobed, as bisection would
   for (int i = 1; i <= probes_; ++i) {

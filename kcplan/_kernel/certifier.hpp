@@ -19,6 +19,12 @@
 
 namespace kcplan {
 
+/// The probes' schedule (kcplan/planning/certifier.py: PROBE_WARMUP, PROBE_ODDS,
+/// PROBE_EVERY): every edge is probed while fewer than kProbeWarmup were, or while at
+/// least one probed edge in kProbeOdds was rejected by a probe; otherwise every
+/// kProbeEvery-th edge, so that the rate stays measured.
+constexpr std::int64_t kProbeWarmup = 64, kProbeOdds = 5, kProbeEvery = 16;
+
 /// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
 struct CertifierCounters {
   std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
@@ -26,7 +32,7 @@ struct CertifierCounters {
                certified_by_endpoints = 0, certified_one_guard = 0, guards = 0,
                endpoint_guards = 0, cached_guards = 0, bisection_nodes = 0,
                collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0,
-               probes = 0;
+               probes = 0, probed_edges = 0;
 };
 
 /// Options of an EdgeCertifier; the defaults are the Python certifier's.
@@ -53,7 +59,8 @@ struct CertifierOptions {
 /// through a blocked cell or a colliding core capsule rejects it, and so does a colliding
 /// probe, one of `probes` collision queries at the bisection points 1/2, 1/4, 3/4, 1/8, ...
 /// of what is left open (a colliding pose proves the edge not free at a collision query's
-/// price, before any guard is paid for); (4) missing endpoint
+/// price, before any guard is paid for), asked while probes reject at least one edge in
+/// kProbeOdds (see probing()); (4) missing endpoint
 /// guards are measured and cached; (5) advancement places guards in the middle of what is
 /// left open until nothing is (certified), one touches an obstacle or makes no progress
 /// (rejected), or max_guards were placed ("not proven": rejected). A pose outside the
@@ -93,6 +100,7 @@ class EdgeCertifier {
   void reach(const Guard& guard, const Edge& edge, double m, double s0, double s1, double& lo,
              double& hi);
   bool reject(std::int64_t& reason);
+  bool probing();
   bool probe(const Edge& edge, double lo, double hi);
   bool advance(const Edge& edge, double lo, double hi);
   bool sample(const Edge& edge, double resolution, double lo, double hi);
@@ -103,6 +111,7 @@ class EdgeCertifier {
   std::vector<double> covered_;
   bool use_region_ = false, discrete_ = false, sweep_test_ = false;
   int max_guards_, probes_;
+  std::int64_t probe_skips_ = 0;
   double horizon_, margin_, core_radius_;
   PoseDomain domain_;
   GuardCache cache_;
