@@ -8,11 +8,13 @@
 from kcplan.arm.bounds import carries, pair_speeds, point_speeds, speeds
 from kcplan.arm.kinematics import body_frames, joint_axes, joint_frames
 from kcplan.arm.model import ArmBody, ArmError, ArmModel, load_arm
+from kcplan.arm.world import ArmWorld
 
 __all__ = [
     "ArmBody",
     "ArmError",
     "ArmModel",
+    "ArmWorld",
     "body_frames",
     "carries",
     "joint_axes",

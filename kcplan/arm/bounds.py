@@ -46,17 +46,17 @@ from numpy.typing import NDArray
 
 from kcplan.arm.model import ArmModel
 
-__all__ = ["carries", "pair_speeds", "point_speeds", "speeds"]
+__all__ = ["carries", "chain_speeds", "pair_speeds", "point_speeds", "speeds"]
 
 
-def carries(arm: ArmModel) -> NDArray[np.bool_]:
-    """``C[k, j]``: joint ``j`` of the group (state order) carries body ``k``, shape
-    ``(len(arm.bodies), arm.dof)``."""
+def carries(arm: ArmModel, joints: Sequence[int] | None = None) -> NDArray[np.bool_]:
+    """``C[k, j]``: joint ``j`` of the group (state order) carries body ``k`` (or the part
+    carried by joint ``joints[k]`` of the reduced model), shape ``(parts, arm.dof)``."""
     model = arm.model
     state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
-    out = np.zeros((len(arm.bodies), arm.dof), dtype=bool)
-    for k, body in enumerate(arm.bodies):
-        i = body.joint
+    joints = [b.joint for b in arm.bodies] if joints is None else list(joints)
+    out = np.zeros((len(joints), arm.dof), dtype=bool)
+    for k, i in enumerate(joints):
         while i > 0:
             if i in state_of:
                 out[k, state_of[i]] = True
@@ -69,6 +69,18 @@ def point_speeds(arm: ArmModel) -> NDArray[np.float64]:
     (metres per radian, or 1 for a prismatic joint; 0 where ``j`` does not carry ``k``),
     for every configuration in the limits; shape ``(len(arm.bodies), arm.dof)``. See the
     module docstring for the proof."""
+    joints = [b.joint for b in arm.bodies]
+    reaches = [float(np.linalg.norm(b.placement[:3, 3]) + b.semi_axes.max()) for b in arm.bodies]
+    return chain_speeds(arm, joints, reaches)
+
+
+def chain_speeds(
+    arm: ArmModel, joints: Sequence[int], reaches: Sequence[float]
+) -> NDArray[np.float64]:
+    """``rho[k, j]`` of :func:`point_speeds` for any parts: part ``k`` is carried by joint
+    ``joints[k]`` of the reduced model and every point of it lies within ``reaches[k]`` of
+    that joint's origin (a body's centre distance plus its largest semi-axis, or a mesh's
+    farthest vertex). Shape ``(len(joints), arm.dof)``."""
     model = arm.model
     state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
     # how far joint i's origin lies from its parent's, over the whole joint box
@@ -78,10 +90,8 @@ def point_speeds(arm: ArmModel) -> NDArray[np.float64]:
         j = state_of.get(i)
         if j is not None and arm.kinds[j] == "prismatic":
             hop[i] += max(abs(arm.lower[j]), abs(arm.upper[j]))
-    rho = np.zeros((len(arm.bodies), arm.dof))
-    for k, body in enumerate(arm.bodies):
-        reach = float(np.linalg.norm(body.placement[:3, 3]) + body.semi_axes.max())
-        i = body.joint
+    rho = np.zeros((len(joints), arm.dof))
+    for k, (i, reach) in enumerate(zip(joints, reaches, strict=True)):
         while i > 0:  # walking up: reach is the bound on |x - o_i|
             if i in state_of:
                 j = state_of[i]

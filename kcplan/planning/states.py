@@ -34,6 +34,11 @@ def state_pose(state, n: int) -> np.ndarray:
     return np.array([state.getX(), state.getY(), state.getZ(), r.x, r.y, r.z, r.w])
 
 
+def joint_state(state, dof: int) -> np.ndarray:
+    """Joint vector of a ``RealVectorStateSpace`` state, shape ``(dof,)``."""
+    return np.array([state[j] for j in range(dof)])
+
+
 def set_state(state, pose: ArrayLike, n: int) -> None:
     """Write a flat pose into an OMPL state (quaternions are normalised)."""
     p = np.asarray(pose, dtype=float)

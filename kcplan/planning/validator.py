@@ -7,6 +7,11 @@ Usable in any OMPL setup on SE(2) or SE(3)::
     si.setMotionValidator(mv)
     ...
 
+and, for an arm, on the ``RealVectorStateSpace`` of its planning group (bounds: the
+joint limits), with ``robot`` a :class:`kcplan.arm.ArmModel` and ``world`` its
+:class:`kcplan.arm.ArmWorld` (edges decided by
+:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`).
+
 The validator keeps no reference to ``si`` (only to its state space): ``si`` holds the
 validator through a C++ ``shared_ptr`` that Python's collector cannot see, so a reference
 back would make a cycle that outlives the script, and nanobind would report its objects
@@ -33,11 +38,13 @@ from collections.abc import Sequence
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
+from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
+from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
-from kcplan.planning.states import state_pose
+from kcplan.planning.states import joint_state, state_pose
 from kcplan.world.collision import CollisionWorld
 
 __all__ = ["KCMotionValidator"]
@@ -50,9 +57,10 @@ class KCMotionValidator(ob.MotionValidator):
     ----------
     si : ompl.base.SpaceInformation
         On an ``SE2StateSpace`` or ``SE3StateSpace``.
-    robot : Robot or array_like
+    robot : Robot or array_like or ArmModel
         The robot (:class:`kcplan.geometry.robot.Robot`), or the semi-axes ``(2,)`` or
-        ``(3,)`` of one ellipse/ellipsoid at the origin, in the state space's length unit.
+        ``(3,)`` of one ellipse/ellipsoid at the origin, in the state space's length unit;
+        or an arm (:class:`kcplan.arm.ArmModel`, with an :class:`kcplan.arm.ArmWorld`).
     world : object
         ``in_collision(pose) -> bool`` and ``safe_body_clearances(pose)`` for flat
         poses ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``; ``free_regions`` for the
@@ -70,8 +78,9 @@ class KCMotionValidator(ob.MotionValidator):
         :data:`kcplan.planning.ladder.DEFAULT_LADDER`).
     horizon : float, optional
         Region horizon in length units (default the largest semi-axis).
-    max_guards : int
-        Guards per edge before giving up ("not proven" rejects the edge).
+    max_guards : int, optional
+        Guards per edge before giving up ("not proven" rejects the edge); default 64, or
+        256 for an arm (whose joint-space edges are long).
     sweep_test : bool, optional
         Reject an edge whose robot core (ball of radius ``min(a)`` for one body) sweeps into an
         obstacle with one collision query before measuring guards (default: when the
@@ -98,13 +107,18 @@ class KCMotionValidator(ob.MotionValidator):
         fallback: str = "bisection",
         inflations: Sequence[float] | None = None,
         horizon: float | None = None,
-        max_guards: int = 64,
+        max_guards: int | None = None,
         sweep_test: bool | None = None,
         backend: str | None = None,
         probes: int = DEFAULT_PROBES,
     ):
         super().__init__(si)
         self.space = si.getStateSpace()  # not si itself: see the module docstring
+        self.error: Exception | None = None
+        if isinstance(world, ArmWorld):
+            self._init_arm(robot, world, certificates, fallback, max_guards, backend)
+            return
+        max_guards = 64 if max_guards is None else max_guards
         robot = Robot.of(robot)
         ladder = None
         if certificates is not None and "polytope" in certificates:
@@ -134,12 +148,29 @@ class KCMotionValidator(ob.MotionValidator):
         self.backend = backend
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
-        self.error: Exception | None = None
+        self._read = lambda state, n=self.n: state_pose(state, n)
         if backend == "kernel":
             # the hot path: one call into the kernel with the pose(s), nothing else
             self.state_valid = self._valid_kernel_se2 if self.n == 2 else self._valid_kernel_se3
             if fallback != "discrete":  # the discrete fallback needs OMPL's resolution
                 self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
+
+    def _init_arm(self, arm, world, certificates, fallback, max_guards, backend) -> None:
+        if arm is not world.arm:
+            raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
+        if backend not in (None, "python"):
+            raise ValueError(
+                f"backend: arms are decided by the Python certifier for now, got {backend!r}"
+            )
+        if certificates not in (None, ("ball",), ["ball"]) or fallback != "bisection":
+            raise ValueError(
+                "certificates: arms have the clearance ball ('ball', bisection) for now, "
+                f"got {certificates!r} with {fallback!r}"
+            )
+        self.certifier = ArmEdgeCertifier(world, 256 if max_guards is None else max_guards)
+        self.backend = "python"
+        self.n = arm.dof
+        self._read = lambda state, n=arm.dof: joint_state(state, n)
 
     @property
     def counters(self) -> dict:
@@ -152,7 +183,7 @@ class KCMotionValidator(ob.MotionValidator):
     def state_valid(self, state) -> bool:
         """A state validity check that shares the validator's cache: use it as the
         setup's checker so that edges ending at checked states skip that query."""
-        return self.certifier.state_valid(state_pose(state, self.n))
+        return self.certifier.state_valid(self._read(state))
 
     def _check_kernel_se2(self, s1, s2) -> bool:
         try:
@@ -195,9 +226,7 @@ class KCMotionValidator(ob.MotionValidator):
                 # si's validity-checking resolution times the space's extent
                 step = self.space.getLongestValidSegmentLength()
                 resolution = min(1.0, step / length) if length > 0 else 1.0
-            return bool(
-                self.certifier.check(state_pose(s1, self.n), state_pose(s2, self.n), resolution)
-            )
+            return bool(self.certifier.check(self._read(s1), self._read(s2), resolution))
         except Exception as err:  # through PRM's C++ threads an exception aborts
             return self._fail(err)  # rejecting is always safe; raise_error() re-raises it
 

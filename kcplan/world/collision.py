@@ -41,7 +41,13 @@ from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario, as_scenario
 from kcplan.world.support import box_vertices, piece_supports
 
-__all__ = ["CLEARANCE_RTOL", "CLEARANCE_ATOL", "CollisionWorld", "polygon_prism"]
+__all__ = [
+    "CLEARANCE_RTOL",
+    "CLEARANCE_ATOL",
+    "CollisionWorld",
+    "fcl_obstacle_parts",
+    "polygon_prism",
+]
 
 CLEARANCE_RTOL = 2e-3
 """Relative error allowed for FCL's iterative (GJK) distances. FCL *over*-estimates
@@ -85,6 +91,35 @@ def _embed(R: NDArray, n: int) -> NDArray:
     out = np.eye(3)
     out[:2, :2] = R
     return out
+
+
+def fcl_obstacle_parts(ob: Obstacle, n: int, half_height: float = 1.0) -> list[tuple]:
+    """The FCL pieces of an obstacle, ``[(geometry, transform), ...]`` (a polygon gives one
+    per convex piece); a planar obstacle becomes a prism ``|z| <= half_height`` (see the
+    module docstring)."""
+    identity = fcl.Transform()
+    center3 = np.append(ob.center, 0.0) if n == 2 else ob.center
+    if ob.kind in ("polygon", "box") and n == 2:
+        return [(polygon_prism(p, half_height), identity) for p in ob.pieces]
+    if ob.kind == "box":
+        if np.allclose(ob.rotation, np.eye(3)):
+            return [(fcl.Box(*(2 * ob.extents)), fcl.Transform(center3))]
+        return [(_box3(ob), identity)]
+    if ob.kind in ("circle", "sphere"):
+        return [(fcl.Sphere(float(ob.extents[0])), fcl.Transform(center3))]
+    if ob.kind in ("ellipse", "ellipsoid"):
+        axes = ob.extents if n == 3 else [*ob.extents, float(ob.extents.min())]
+        return [(fcl.Ellipsoid(*axes), fcl.Transform(_embed(ob.rotation, n), center3))]
+    if ob.kind == "convex":
+        faces = np.column_stack([np.full(len(ob.triangles), 3), ob.triangles]).ravel()
+        return [(fcl.Convex(ob.vertices, len(ob.triangles), faces.astype(np.int32)), identity)]
+    if ob.kind == "mesh":
+        model = fcl.BVHModel()
+        model.beginModel(len(ob.vertices), len(ob.triangles))
+        model.addSubModel(ob.vertices, ob.triangles)
+        model.endModel()
+        return [(model, identity)]
+    raise ValueError(f"unknown obstacle kind {ob.kind!r}")  # pragma: no cover
 
 
 class CollisionWorld:
@@ -149,7 +184,7 @@ class CollisionWorld:
         # id of an FCL geometry -> the exact support function of its piece, or None
         self._support_of: dict[int, object] = {}
         for ob in scenario.obstacles:
-            parts = self._fcl_parts(ob)
+            parts = fcl_obstacle_parts(ob, n, self._half_height)
             for (geom, tf), support in zip(parts, piece_supports(ob), strict=True):
                 self._support_of[id(geom)] = support
                 self._objects.append(fcl.CollisionObject(geom, tf))
@@ -200,31 +235,6 @@ class CollisionWorld:
         if self._kernel is None:
             self._kernel = build_kernel_world(self.scenario, self.robot, self._half_height)
         return self._kernel
-
-    def _fcl_parts(self, ob: Obstacle) -> list[tuple]:
-        n, identity = self.dimension, fcl.Transform()
-        center3 = np.append(ob.center, 0.0) if n == 2 else ob.center
-        if ob.kind in ("polygon", "box") and n == 2:
-            return [(polygon_prism(p, self._half_height), identity) for p in ob.pieces]
-        if ob.kind == "box":
-            if np.allclose(ob.rotation, np.eye(3)):
-                return [(fcl.Box(*(2 * ob.extents)), fcl.Transform(center3))]
-            return [(_box3(ob), identity)]
-        if ob.kind in ("circle", "sphere"):
-            return [(fcl.Sphere(float(ob.extents[0])), fcl.Transform(center3))]
-        if ob.kind in ("ellipse", "ellipsoid"):
-            axes = ob.extents if n == 3 else [*ob.extents, float(ob.extents.min())]
-            return [(fcl.Ellipsoid(*axes), fcl.Transform(_embed(ob.rotation, n), center3))]
-        if ob.kind == "convex":
-            faces = np.column_stack([np.full(len(ob.triangles), 3), ob.triangles]).ravel()
-            return [(fcl.Convex(ob.vertices, len(ob.triangles), faces.astype(np.int32)), identity)]
-        if ob.kind == "mesh":
-            model = fcl.BVHModel()
-            model.beginModel(len(ob.vertices), len(ob.triangles))
-            model.addSubModel(ob.vertices, ob.triangles)
-            model.endModel()
-            return [(model, identity)]
-        raise ValueError(f"unknown obstacle kind {ob.kind!r}")  # pragma: no cover
 
     @property
     def n_objects(self) -> int:

@@ -1,0 +1,193 @@
+"""The edge certifier of arms: joint-space edges proved free by the chain's clearance balls.
+
+For the straight edge ``q(s) = q1 + s (q2 - q1)`` a *guard* at ``s = m`` measures, for each
+covering body ``k``, its certain clearance ``d_k`` to the obstacles and, for each self
+pair ``(k, l)``, their certain distance ``d_kl`` (:meth:`kcplan.arm.ArmWorld.
+safe_clearances`). Along the edge no point of body ``k`` moves faster than ``v_k`` per unit
+of ``s``, and no two points of ``k`` and ``l`` approach faster than ``v_kl``
+(:mod:`kcplan.arm.bounds`, Schwarzer, Saha and Latombe 2005). So for ``|s - m| < r`` with
+
+    r = min( min_k d_k / v_k , min_(k,l) d_kl / v_kl )
+
+every body stays clear of every obstacle (it was ``d_k`` away and moved less than
+``d_k``) and of every body it may collide with: the stretch ``(m - r, m + r)`` is free.
+The covers contain the links' collision geometry, so the links are free too. The edge is
+certified when guards cover all of ``[0, 1]``; a guard at a state in contact (``r = 0``)
+rejects it.
+
+This is the ``ca`` certificate of arms (the rigid robots' clearance ball with the chain's
+speeds); it imports neither OMPL nor FCL (the world does the queries).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from kcplan.arm.bounds import carries, point_speeds
+
+__all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier"]
+
+ARM_COUNTER_NAMES = (
+    "edges",
+    "rejected",
+    "rejected_end_state",
+    "rejected_guard",
+    "not_proven",
+    "certified_by_endpoints",
+    "certified_one_guard",
+    "guards",
+    "endpoint_guards",
+    "cached_guards",
+    "bisection_nodes",
+    "collision_queries",
+)
+"""The rigid certifier's counters that arms have (:data:`kcplan.planning.certifier.
+COUNTER_NAMES`), with the same meanings."""
+
+
+class ArmEdgeCertifier:
+    """Prove joint-space edges of an arm free, or reject them (see the module docstring).
+
+    ``check(q1, q2)`` follows OMPL's ``MotionValidator`` contract: ``q1`` is assumed valid,
+    ``q2`` is not. Steps: (1) a state outside the joint limits or not finite rejects the
+    edge with no query; (2) ``q2``'s validity (one collision query, cached); (3) guards at
+    the two ends (cached per state, as the rigid certifier caches them); (4) a guard in
+    the middle of each stretch left open until none is (certified), one is in contact
+    (rejected) or ``max_guards`` were placed ("not proven", rejected).
+
+    Parameters
+    ----------
+    world : kcplan.arm.ArmWorld
+    max_guards : int
+        Guards per edge after the ends before "not proven".
+    cache_entries : int
+        States whose validity and guard are remembered.
+    """
+
+    backend = "python"
+    certificates = ("ball",)
+
+    def __init__(self, world, max_guards: int = 256, cache_entries: int = 200_000):
+        self.world, self.arm = world, world.arm
+        self.n = self.arm.dof
+        self.max_guards = int(max_guards)
+        self._rho = point_speeds(self.arm)
+        C = carries(self.arm)
+        pairs = self.arm.self_pairs
+        # relative speeds count only the joints that carry one body of the pair
+        first, second = pairs[:, 0], pairs[:, 1]
+        self._rho_first = self._rho[first] * (C[first] & ~C[second])
+        self._rho_second = self._rho[second] * (C[second] & ~C[first])
+        self._cache_entries = int(cache_entries)
+        self._valid: dict[bytes, bool] = {}
+        self._guards: dict[bytes, tuple] = {}
+        self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
+        self.covered = {"ball": 0.0}
+        self.fallback = "bisection"
+
+    def _admits(self, q: np.ndarray) -> bool:
+        return self.arm.within_limits(q)
+
+    def state_valid(self, state: ArrayLike) -> bool:
+        """One collision query for a state not seen before (remembered)."""
+        q = np.asarray(state, dtype=float)
+        if not self._admits(q):
+            return False
+        key = q.tobytes()
+        known = self._valid.get(key)
+        if known is None:
+            self.counters["collision_queries"] += 1
+            known = not self.world.in_collision(q)
+            if len(self._valid) < self._cache_entries:
+                self._valid[key] = known
+        return known
+
+    def _measure(self, q: np.ndarray) -> tuple:
+        self.counters["guards"] += 1
+        return self.world.safe_clearances(q)
+
+    def _endpoint(self, q: np.ndarray) -> tuple:
+        key = q.tobytes()
+        guard = self._guards.get(key)
+        if guard is None:
+            self.counters["endpoint_guards"] += 1
+            guard = self._measure(q)
+            if len(self._guards) < self._cache_entries:
+                self._guards[key] = guard
+        else:
+            self.counters["cached_guards"] += 1
+        return guard
+
+    def _radius(self, guard: tuple, speed: np.ndarray, pair_speed: np.ndarray) -> float:
+        """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
+        scene, pairs = guard
+        if (scene <= 0.0).any() or (pairs <= 0.0).any():
+            return 0.0
+        r = math.inf
+        with np.errstate(divide="ignore"):
+            if len(scene):
+                r = min(r, float(np.min(np.where(speed > 0, scene / speed, math.inf))))
+            if len(pairs):
+                r = min(r, float(np.min(np.where(pair_speed > 0, pairs / pair_speed, math.inf))))
+        return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
+
+    def _reject(self, reason: str) -> bool:
+        self.counters["rejected"] += 1
+        self.counters[reason] += 1
+        return False
+
+    def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
+        """True when the whole edge ``q1 -> q2`` is proven free (see the class docs)."""
+        c = self.counters
+        c["edges"] += 1
+        q1, q2 = np.asarray(state1, dtype=float), np.asarray(state2, dtype=float)
+        if q1.shape != (self.n,) or q2.shape != (self.n,):
+            raise ValueError(f"state: expected {self.n} joint values per state")
+        if not (self._admits(q1) and self._admits(q2)):
+            return self._reject("rejected_end_state")
+        if not self.state_valid(q2):
+            return self._reject("rejected_end_state")
+        dq = np.abs(q2 - q1)
+        speed = self._rho @ dq
+        pair_speed = self._rho_first @ dq + self._rho_second @ dq
+        lo = self._radius(self._endpoint(q1), speed, pair_speed)
+        if lo <= 0.0:
+            return self._reject("rejected_guard")
+        hi = 1.0 - self._radius(self._endpoint(q2), speed, pair_speed)
+        if hi >= 1.0:
+            return self._reject("rejected_end_state")
+        if lo >= hi:
+            c["certified_by_endpoints"] += 1
+            self.covered["ball"] += 1.0
+            return True
+        return self._advance(q1, q2, lo, hi, speed, pair_speed)
+
+    def _advance(self, q1, q2, lo, hi, speed, pair_speed) -> bool:
+        c = self.counters
+        pending = [(lo, hi)]
+        guards = 0
+        while pending:
+            s0, s1 = pending.pop()
+            if guards >= self.max_guards:
+                c["bisection_nodes"] += guards
+                return self._reject("not_proven")
+            m = 0.5 * (s0 + s1)
+            r = self._radius(self._measure(q1 + m * (q2 - q1)), speed, pair_speed)
+            guards += 1
+            if r <= 0.0:
+                c["bisection_nodes"] += guards
+                return self._reject("rejected_guard")
+            if r <= 1e-12:
+                c["bisection_nodes"] += guards
+                return self._reject("not_proven")
+            if m - r > s0:
+                pending.append((s0, m - r))
+            if m + r < s1:
+                pending.append((m + r, s1))
+        c["bisection_nodes"] += guards
+        c["certified_one_guard"] += guards == 1
+        self.covered["ball"] += 1.0
+        return True

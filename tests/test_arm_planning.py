@@ -1,0 +1,149 @@
+"""Certified joint-space edges of arms (kcplan.planning.arm_certifier) and planning with
+them in OMPL, every accepted edge re-checked on the links' own meshes."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from ompl import base as ob
+from ompl import geometric as og
+
+from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm.verify import verify_arm_path
+from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
+from kcplan.planning.certifier import COUNTER_NAMES
+from kcplan.planning.validator import KCMotionValidator
+from kcplan.world import parse_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+PANDA = ROOT / "scenarios" / "arm" / "panda"
+GROUP = [f"panda_joint{i}" for i in range(1, 8)]
+READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+
+
+def _obstacles(specs):
+    data = {
+        "name": "scene",
+        "dimension": 3,
+        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
+        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
+        "start": {"position": [0.0, 0.0, 0.0]},
+        "goal": {"position": [0.0, 0.0, 0.0]},
+        "obstacles": specs,
+    }
+    return parse_scenario(data, check=False).obstacles
+
+
+SCENE = [
+    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},  # a shelf board
+    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},  # the floor
+    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
+]
+
+
+@pytest.fixture(scope="module")
+def panda(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
+        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf")
+
+
+@pytest.fixture(scope="module")
+def scene(panda):
+    return ArmWorld(panda, _obstacles(SCENE)), _obstacles(SCENE)
+
+
+def test_the_arm_counters_are_the_rigid_certifiers():
+    assert set(ARM_COUNTER_NAMES) <= set(COUNTER_NAMES)
+
+
+def test_accepted_arm_edges_are_free_on_the_meshes(panda, scene):
+    """Random edges of every length between valid states: every accepted edge is free on
+    the links' collision meshes (checked without gaps, independent of the covers), and
+    a good share of the short free edges is accepted."""
+    world, obstacles = scene
+    certifier = ArmEdgeCertifier(world)
+    rng = np.random.default_rng(11)
+    accepted = short_accepted = short = 0
+    for scale in (1.0, 0.3, 0.05):
+        for _ in range(25):
+            q1 = rng.uniform(panda.lower, panda.upper)
+            if not certifier.state_valid(q1):
+                continue
+            q2 = np.clip(q1 + scale * rng.uniform(-3, 3, 7), panda.lower, panda.upper)
+            if certifier.check(q1, q2):
+                accepted += 1
+                short_accepted += scale < 0.1
+                check = verify_arm_path(panda, obstacles, [q1, q2])
+                assert not check.collides, (q1.tolist(), q2.tolist(), check)
+            short += scale < 0.1
+    assert accepted > 10 and short_accepted >= 0.5 * short
+    c = certifier.counters
+    assert c["edges"] == c["rejected"] + accepted
+    reasons = ("rejected_end_state", "rejected_guard", "not_proven")
+    assert sum(c[k] for k in reasons) == c["rejected"]
+
+
+def test_an_edge_that_meets_the_scene_midway_is_rejected(panda, scene):
+    """Both ends free (covers and meshes), the meshes in contact near s = 0.59."""
+    world, obstacles = scene
+    certifier = ArmEdgeCertifier(world)
+    q1 = np.array([-1.04, 1.68, 0.97, -0.74, 1.68, 3.64, 0.98])
+    q2 = np.array([-0.76, 1.3, 1.64, -0.31, 2.39, 3.82, 0.55])
+    assert certifier.state_valid(q1) and certifier.state_valid(q2)
+    for q in (q1, q2):
+        assert not verify_arm_path(panda, obstacles, [q, q]).collides
+    check = verify_arm_path(panda, obstacles, [q1, q2])
+    assert check.collides and 0.4 < check.where[1] < 0.7
+    assert not certifier.check(q1, q2) and not certifier.check(q2, q1)
+    assert certifier.counters["rejected_guard"] + certifier.counters["not_proven"] == 2
+
+
+def test_states_outside_the_limits_are_never_free(panda, scene):
+    world, _ = scene
+    certifier = ArmEdgeCertifier(world)
+    before = dict(world.counters)
+    for bad in ([math.nan] * 7, [0.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0], [1e308] * 7):
+        assert not certifier.state_valid(bad)
+        assert not certifier.check(READY, bad)
+    assert world.counters == before  # no query was spent on them
+    assert certifier.counters["rejected_end_state"] == 3
+    with pytest.raises(ValueError, match="7 joint values"):
+        certifier.check(READY, READY[:6])
+
+
+def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
+    """OMPL's RRT-Connect on the group's joint box with KCMotionValidator(si, arm, world):
+    the path is free on the meshes, without gaps."""
+    world, obstacles = scene
+    space = ob.RealVectorStateSpace(panda.dof)
+    bounds = ob.RealVectorBounds(panda.dof)
+    for j in range(panda.dof):
+        bounds.setLow(j, float(panda.lower[j]))
+        bounds.setHigh(j, float(panda.upper[j]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    mv = KCMotionValidator(si, panda, world)
+    si.setMotionValidator(mv)
+    si.setStateValidityChecker(mv.state_valid)
+    si.setup()
+    start, goal = si.allocState(), si.allocState()
+    target = np.array([1.64, -0.18, -2.46, -0.78, 1.21, 1.28, 1.13])
+    for state, values in ((start, READY), (goal, target)):
+        for j, v in enumerate(values):
+            state[j] = float(v)
+    assert mv.state_valid(start) and mv.state_valid(goal)
+    pdef = ob.ProblemDefinition(si)
+    pdef.setStartAndGoalStates(start, goal)
+    planner = og.RRTConnect(si)
+    planner.setProblemDefinition(pdef)
+    planner.setup()
+    assert planner.solve(20.0)
+    mv.raise_error()
+    path = pdef.getSolutionPath()
+    states = [np.array([s[j] for j in range(panda.dof)]) for s in path.getStates()]
+    assert np.allclose(states[0], READY) and np.allclose(states[-1], target)
+    check = verify_arm_path(panda, obstacles, states)
+    assert not check.collides and check.queries > len(states)
+    assert mv.counters["edges"] > 0 and mv.counters["rejected"] < mv.counters["edges"]
