@@ -122,6 +122,15 @@ CASES = [
         ("cover.md", "cover.csv", "cover.png"),
     ),
     Case(
+        "edge_outcomes.py",
+        (CORRIDOR, "kc-rrtconnect", "1,2", "--probes", "1", "--time", "5"),
+        (
+            r"^seed 1: solved True in ",
+            rf"^\| certified after guards \| [1-9]\d* \| {NUMBER} \| {NUMBER} \| [1-9]\d* \|",
+            rf"^\| rejected_end_state \| [1-9]\d* \| {NUMBER} \| {NUMBER} \| 0 \| [1-9]\d* \|$",
+        ),
+    ),
+    Case(
         "compare_validators.py",
         (CORRIDOR, "--runs", "1", "--time", "2"),
         tuple(
