@@ -27,25 +27,19 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan.arm.bounds import carries, point_speeds
+from kcplan.planning.certifier import COUNTER_NAMES
 
 __all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier"]
 
-ARM_COUNTER_NAMES = (
-    "edges",
-    "rejected",
-    "rejected_end_state",
-    "rejected_guard",
-    "not_proven",
-    "certified_by_endpoints",
-    "certified_one_guard",
-    "guards",
-    "endpoint_guards",
-    "cached_guards",
-    "bisection_nodes",
-    "collision_queries",
+ARM_COUNTER_NAMES = tuple(
+    name
+    for name in COUNTER_NAMES
+    if name not in ("rejected_sweep", "rejected_occupancy", "rejected_probe", "probes")
+    and name not in ("probed_edges", "occupancy_rejections", "occupancy_queries")
 )
-"""The rigid certifier's counters that arms have (:data:`kcplan.planning.certifier.
-COUNTER_NAMES`), with the same meanings."""
+"""The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
+the same meanings, less those of the steps arms do not have yet (core sweep, occupancy
+grid, probes)."""
 
 
 class ArmEdgeCertifier:
