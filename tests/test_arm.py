@@ -255,3 +255,64 @@ def test_the_chain_bounds_a_prismatic_joint(tmp_path):
         _check_speeds(arm, rng.uniform(arm.lower, arm.upper), rng.uniform(arm.lower, arm.upper))
     moved, bound = _check_speeds(arm, np.array([0.0, 0.3]), np.array([1.5, 0.3]))
     assert moved == pytest.approx([1.5, 1.5]) and bound == pytest.approx([1.5, 1.5])
+
+
+MBM = ROOT.parent / "shared" / "data" / "external" / "mbm" / "panda" / "problems.tar.bz2"
+
+
+def test_an_mbm_problem_is_read_with_its_obstacles_goal_and_allowed_pairs():
+    from kcplan.arm.mbm import read_mbm_archive
+
+    problem = read_mbm_archive(MBM, "box", 1)
+    assert problem.joints == tuple(GROUP)
+    assert problem.start == pytest.approx([0, -0.785, 0, -2.356, 0, 1.571, 0.785])
+    assert problem.goal[:2] == pytest.approx([0.4534448383669427, 1.7628])
+    assert problem.start_state["panda_finger_joint1"] == pytest.approx(0.065)
+    kinds = [ob.kind for ob in problem.obstacles]
+    assert kinds[0] == "cylinder" and kinds.count("box") == len(kinds) - 1
+    can = problem.obstacles[0]  # dimensions [height 0.14, radius 0.03]
+    assert can.extents == pytest.approx([0.03, 0.03, 0.07])
+    assert can.center == pytest.approx(
+        [0.5408380884576693, 0.3580155146897772, -0.3762264457751537]
+    )
+    assert frozenset(("panda_hand", "panda_leftfinger")) in problem.allowed
+    assert frozenset(("panda_link0", "panda_hand")) not in problem.allowed
+
+
+def test_the_scenes_allowed_pairs_are_not_checked(panda):
+    """The MBM scene allows link5 and the hand to touch: the world checks the SRDF's pairs
+    less those; a wrist bent so that their covers overlap is then valid."""
+    from kcplan.arm import ArmWorld
+
+    bent = np.array([0.0, -0.3, 0.0, -1.6, 0.0, 2.2, 0.785])
+    link5_hand = frozenset(("panda_link5", "panda_hand"))
+    link5_link7 = frozenset(("panda_link5", "panda_link7"))
+    strict = ArmWorld(panda)
+    assert strict.in_collision(bent)
+    relaxed = ArmWorld(panda, allowed={link5_hand, link5_link7})
+    assert len(relaxed.self_pairs) == len(strict.self_pairs) - 2
+    assert not relaxed.in_collision(bent)
+
+
+def test_bad_mbm_files_are_refused_with_one_line(tmp_path):
+    from kcplan.arm.mbm import MbmError, read_mbm_archive, read_mbm_problem
+
+    scene, request = tmp_path / "scene.yaml", tmp_path / "request.yaml"
+    cone = "primitives: [{type: cone, dimensions: [1, 2]}]"
+    scene.write_text(f"world: {{collision_objects: [{{id: a, {cone}, "
+                     "primitive_poses: [{position: [0, 0, 0]}]}]}")  # fmt: skip
+    goal = "goal_constraints: [{joint_constraints: [{joint_name: a, position: 1}]}]"
+    request.write_text(f"start_state: {{joint_state: {{name: [a], position: [0]}}}}\n{goal}")
+    with pytest.raises(MbmError, match=r"scene.yaml: world.collision_objects\[0\].primitives: "
+                       r"expected a box, cylinder or sphere"):  # fmt: skip
+        read_mbm_problem(scene, request)
+    request.write_text("start_state: {joint_state: {name: [a], position: [0]}}")
+    with pytest.raises(MbmError, match=r"request.yaml: goal_constraints\[0\].joint_constraints"):
+        read_mbm_problem(scene, request)
+    request.write_text(": : :")
+    with pytest.raises(MbmError, match=r"request.yaml: expected YAML"):
+        read_mbm_problem(scene, request)
+    with pytest.raises(MbmError, match=r"problem: expected one of table_pick"):
+        read_mbm_archive(MBM, "shelf", 1)
+    with pytest.raises(MbmError, match=r"expected one box scene 101, found 0"):
+        read_mbm_archive(MBM, "box", 101)

@@ -122,6 +122,15 @@ CASES = [
         ("cover.md", "cover.csv", "cover.png"),
     ),
     Case(
+        "mbm_validity.py",
+        ("--per-class", "1", "--bodies", "1"),
+        (
+            r"^700 problems read in ",
+            r"^\| 1 \| box \| 1 \| [01] / 1 \| [01] / 1 \| [012] \|$",
+            r"^\| 1 \| all \| 7 \| \d / 7 \| \d / 7 \| \d+ \|$",
+        ),
+    ),
+    Case(
         "edge_outcomes.py",
         (CORRIDOR, "kc-rrtconnect", "1,2", "--probes", "1", "--time", "5"),
         (

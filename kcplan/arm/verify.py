@@ -13,7 +13,7 @@ could hide a contact. A distance at or below ``tolerance`` is a collision.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import fcl
@@ -78,10 +78,12 @@ def verify_arm_path(
     states: Sequence[ArrayLike],
     tolerance: float = 1e-6,
     max_queries: int = 1_000_000,
+    allowed: Collection[frozenset] = (),
 ) -> ArmPathCheck:
     """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints` order)
     without gaps against ``obstacles`` and self-collision (the pairs of
-    :attr:`ArmModel.geometry`); see the module docstring."""
+    :attr:`ArmModel.geometry` whose links are not an ``allowed`` pair); see the module
+    docstring."""
     import pinocchio as pin
 
     geometry = arm.geometry
@@ -92,8 +94,15 @@ def verify_arm_path(
         # the geometry's points lie within its placement's length plus its own reach
         reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)
         joints.append(int(obj.parentJoint))
-    pairs = np.array([(p.first, p.second) for p in geometry.collisionPairs], dtype=int)
-    pairs = pairs.reshape(-1, 2)
+    link = [arm.model.frames[obj.parentFrame].name for obj in geometry.geometryObjects]
+    pairs = np.array(
+        [
+            (p.first, p.second)
+            for p in geometry.collisionPairs
+            if frozenset((link[p.first], link[p.second])) not in allowed
+        ],
+        dtype=int,
+    ).reshape(-1, 2)
     rho = chain_speeds(arm, joints, reaches)
     C = carries(arm, joints)
     scene = []

@@ -15,7 +15,7 @@ sound.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 import fcl
 import numpy as np
@@ -26,7 +26,17 @@ from kcplan.arm.model import ArmModel
 from kcplan.world.collision import CLEARANCE_ATOL, CLEARANCE_RTOL, fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
 
-__all__ = ["ArmWorld"]
+__all__ = ["ArmWorld", "checked_pairs"]
+
+
+def checked_pairs(arm: ArmModel, allowed: Collection[frozenset]) -> NDArray[np.int64]:
+    """The body pairs of ``arm.self_pairs`` whose links are not an ``allowed`` pair."""
+    keep = [
+        (i, j)
+        for i, j in arm.self_pairs
+        if frozenset((arm.bodies[i].link, arm.bodies[j].link)) not in allowed
+    ]
+    return np.array(keep, dtype=np.int64).reshape(-1, 2)
 
 
 class ArmWorld:
@@ -40,6 +50,9 @@ class ArmWorld:
     size : float, optional
         Size of the scene in metres, for FCL's absolute error allowance (default: the
         larger of 2 m and the obstacles' extent).
+    allowed : collection of frozenset of str, optional
+        Link pairs allowed to touch (a scene's allowed collision matrix): their bodies
+        are not checked against each other.
 
     Notes
     -----
@@ -49,10 +62,17 @@ class ArmWorld:
     """
 
     def __init__(
-        self, arm: ArmModel, obstacles: Sequence[Obstacle] = (), size: float | None = None
+        self,
+        arm: ArmModel,
+        obstacles: Sequence[Obstacle] = (),
+        size: float | None = None,
+        allowed: Collection[frozenset] = (),
     ):
         self.arm = arm
         self.obstacles = tuple(obstacles)
+        self.allowed = frozenset(allowed)
+        self.self_pairs = checked_pairs(arm, self.allowed)
+        """The pairs of :attr:`ArmModel.self_pairs` whose links are not allowed to touch."""
         self._bodies = [
             fcl.CollisionObject(fcl.Ellipsoid(*b.semi_axes.tolist()), fcl.Transform())
             for b in arm.bodies
@@ -94,7 +114,7 @@ class ArmWorld:
                 if data.result.is_collision:
                     return True
         request = fcl.CollisionRequest()
-        for i, j in self.arm.self_pairs:
+        for i, j in self.self_pairs:
             result = fcl.CollisionResult()
             if fcl.collide(self._bodies[i], self._bodies[j], request, result):
                 return True
@@ -112,9 +132,9 @@ class ArmWorld:
                 data = fcl.DistanceData()
                 self._manager.distance(obj, data, fcl.defaultDistanceCallback)
                 scene[k] = max(float(data.result.min_distance), 0.0)
-        pairs = np.empty(len(self.arm.self_pairs))
+        pairs = np.empty(len(self.self_pairs))
         request = fcl.DistanceRequest()
-        for m, (i, j) in enumerate(self.arm.self_pairs):
+        for m, (i, j) in enumerate(self.self_pairs):
             result = fcl.DistanceResult()
             pairs[m] = max(fcl.distance(self._bodies[i], self._bodies[j], request, result), 0.0)
         return scene, pairs

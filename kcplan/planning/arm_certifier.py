@@ -70,7 +70,7 @@ class ArmEdgeCertifier:
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
         C = carries(self.arm)
-        pairs = self.arm.self_pairs
+        pairs = world.self_pairs
         # relative speeds count only the joints that carry one body of the pair
         first, second = pairs[:, 0], pairs[:, 1]
         self._rho_first = self._rho[first] * (C[first] & ~C[second])

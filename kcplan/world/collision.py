@@ -107,6 +107,9 @@ def fcl_obstacle_parts(ob: Obstacle, n: int, half_height: float = 1.0) -> list[t
         return [(_box3(ob), identity)]
     if ob.kind in ("circle", "sphere"):
         return [(fcl.Sphere(float(ob.extents[0])), fcl.Transform(center3))]
+    if ob.kind == "cylinder":  # arm scenes (kcplan.arm.mbm); extents (r, r, h / 2)
+        radius, half = float(ob.extents[0]), float(ob.extents[2])
+        return [(fcl.Cylinder(radius, 2.0 * half), fcl.Transform(ob.rotation, center3))]
     if ob.kind in ("ellipse", "ellipsoid"):
         axes = ob.extents if n == 3 else [*ob.extents, float(ob.extents.min())]
         return [(fcl.Ellipsoid(*axes), fcl.Transform(_embed(ob.rotation, n), center3))]

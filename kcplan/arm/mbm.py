@@ -1,0 +1,236 @@
+"""MotionBenchMaker problems: a MoveIt PlanningScene and MotionPlanRequest, read.
+
+A problem is two YAML files (``sceneNNNN.yaml``, ``requestNNNN.yaml``; see
+``shared/data/external/mbm/SOURCE.md``):
+
+* the scene's ``world.collision_objects``: primitives ``box`` (``dimensions``: full sizes
+  x, y, z) and ``cylinder`` (``dimensions: [height, radius]``, axis along local z), each
+  at a ``primitive_poses`` entry (``position``, ``orientation`` as a quaternion x, y, z,
+  w), in the robot's base frame; its ``allowed_collision_matrix`` over the robot's links;
+* the request's ``start_state.joint_state`` (names, positions) and
+  ``goal_constraints[0].joint_constraints`` (one goal configuration of the planning
+  group, whose joints are the goal's, in the order given).
+
+Obstacles come back as :class:`kcplan.world.scenario.Obstacle` (kinds ``box``,
+``sphere`` and ``cylinder``; a cylinder's ``extents`` are ``(r, r, h / 2)``).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import tarfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from kcplan.geometry.pose import quaternion_matrix
+from kcplan.world.scenario import Obstacle
+
+__all__ = [
+    "MBM_CLASSES",
+    "MbmError",
+    "MbmProblem",
+    "load_mbm_archive",
+    "read_mbm_archive",
+    "read_mbm_problem",
+]
+
+MBM_CLASSES = (
+    "table_pick",
+    "table_under_pick",
+    "box",
+    "bookshelf_small",
+    "bookshelf_tall",
+    "bookshelf_thin",
+    "cage",
+)
+"""The seven problem classes of MotionBenchMaker, as VAMP ships them."""
+
+
+class MbmError(ValueError):
+    """A problem that cannot be read; ``str(err)`` is ``FILE: FIELD: expected ..., got ...``."""
+
+
+@dataclass(frozen=True)
+class MbmProblem:
+    """One MotionBenchMaker problem.
+
+    Attributes
+    ----------
+    obstacles : tuple of Obstacle
+    joints : tuple of str
+        The planning group: the goal's joints, in the goal's order.
+    start, goal : ndarray, shape (len(joints),)
+    start_state : dict of str to float
+        Every joint of the request's start state (fingers included).
+    allowed : frozenset of frozenset of str
+        Link pairs the scene's allowed collision matrix allows to touch.
+    """
+
+    obstacles: tuple[Obstacle, ...]
+    joints: tuple[str, ...]
+    start: np.ndarray
+    goal: np.ndarray
+    start_state: dict
+    allowed: frozenset
+
+
+def _field(data, path: str, source: str):
+    value = data
+    for key in path.split("."):
+        if not isinstance(value, dict) or key not in value:
+            raise MbmError(f"{source}: {path}: expected it, found none")
+        value = value[key]
+    return value
+
+
+def _obstacles(scene: dict, source: str) -> tuple[Obstacle, ...]:
+    out: list[Obstacle] = []
+    objects = _field(scene, "world.collision_objects", source) or []
+    for k, obj in enumerate(objects):
+        where = f"world.collision_objects[{k}]"
+        primitives, poses = obj.get("primitives") or [], obj.get("primitive_poses") or []
+        if len(primitives) != len(poses):
+            raise MbmError(f"{source}: {where}: expected a pose per primitive")
+        for shape, pose in zip(primitives, poses, strict=True):
+            center = np.asarray(pose.get("position"), dtype=float)
+            q = np.asarray(pose.get("orientation", [0, 0, 0, 1]), dtype=float)
+            dims = np.asarray(shape.get("dimensions"), dtype=float)
+            if center.shape != (3,) or q.shape != (4,) or not np.isfinite([*center, *q]).all():
+                raise MbmError(f"{source}: {where}: expected a position and a quaternion")
+            R = quaternion_matrix(q / np.linalg.norm(q))
+            spec = {"id": obj.get("id", ""), "type": shape.get("type")}
+            kind = shape.get("type")
+            if kind == "box" and dims.shape == (3,) and (dims > 0).all():
+                out.append(Obstacle("box", len(out), spec, center, R, 0.5 * dims))
+            elif kind == "cylinder" and dims.shape == (2,) and (dims > 0).all():
+                height, radius = dims
+                extents = np.array([radius, radius, 0.5 * height])
+                out.append(Obstacle("cylinder", len(out), spec, center, R, extents))
+            elif kind == "sphere" and dims.shape == (1,) and dims[0] > 0:
+                radii = np.full(3, dims[0])
+                out.append(Obstacle("sphere", len(out), spec, center, np.eye(3), radii))
+            else:
+                raise MbmError(
+                    f"{source}: {where}.primitives: expected a box, cylinder or sphere with "
+                    f"positive dimensions, got {kind!r} {dims.tolist()}"
+                )
+    return tuple(out)
+
+
+def _allowed(scene: dict) -> frozenset:
+    acm = scene.get("allowed_collision_matrix") or {}
+    names, rows = acm.get("entry_names") or [], acm.get("entry_values") or []
+    pairs = set()
+    for i, row in enumerate(rows):
+        for j, value in enumerate(row):
+            if value and i != j and i < len(names) and j < len(names):
+                pairs.add(frozenset((names[i], names[j])))
+    return frozenset(pairs)
+
+
+def _problem(scene: dict, request: dict, scene_source: str, request_source: str) -> MbmProblem:
+    joint_state = _field(request, "start_state.joint_state", request_source)
+    names, positions = joint_state.get("name") or [], joint_state.get("position") or []
+    if len(names) != len(positions):
+        raise MbmError(f"{request_source}: start_state.joint_state: expected a position per name")
+    start_state = {str(n): float(p) for n, p in zip(names, positions, strict=True)}
+    goals = request.get("goal_constraints") or []
+    if not goals or not goals[0].get("joint_constraints"):
+        raise MbmError(f"{request_source}: goal_constraints[0].joint_constraints: expected it")
+    constraints = goals[0]["joint_constraints"]
+    joints = tuple(str(c["joint_name"]) for c in constraints)
+    missing = [j for j in joints if j not in start_state]
+    if missing:
+        raise MbmError(
+            f"{request_source}: start_state: expected the goal's joints, missing {missing}"
+        )
+    start = np.array([start_state[j] for j in joints])
+    goal = np.array([float(c["position"]) for c in constraints])
+    return MbmProblem(
+        _obstacles(scene, scene_source), joints, start, goal, start_state, _allowed(scene)
+    )
+
+
+def _load(text: str | bytes, source: str) -> dict:
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        raise MbmError(f"{source}: expected YAML, got: {str(err).splitlines()[0]}") from None
+    if not isinstance(data, dict):
+        raise MbmError(f"{source}: expected a mapping")
+    return data
+
+
+def read_mbm_problem(scene: str | os.PathLike, request: str | os.PathLike) -> MbmProblem:
+    """Read one problem from its scene and request files."""
+    texts = []
+    for path in (scene, request):
+        try:
+            texts.append(Path(path).read_text())
+        except OSError as err:
+            raise MbmError(f"{os.fspath(path)}: cannot read the file: {err.strerror}") from None
+    return _problem(
+        _load(texts[0], os.fspath(scene)), _load(texts[1], os.fspath(request)),
+        os.fspath(scene), os.fspath(request),
+    )  # fmt: skip
+
+
+def read_mbm_archive(archive: str | os.PathLike, problem: str, index: int) -> MbmProblem:
+    """Read problem ``index`` (1 to 100) of class ``problem`` (:data:`MBM_CLASSES`) from
+    VAMP's ``problems.tar.bz2`` (folders ``problems/CLASS_ROBOT/``)."""
+    if problem not in MBM_CLASSES:
+        raise MbmError(f"problem: expected one of {', '.join(MBM_CLASSES)}, got {problem!r}")
+    try:
+        with tarfile.open(archive) as tar:
+            members = {m.name: m for m in tar.getmembers() if m.isfile()}
+            found = {}
+            for kind in ("scene", "request"):
+                suffix = f"/{kind}{index:04d}.yaml"
+                names = [n for n in members if f"/{problem}_" in n and n.endswith(suffix)]
+                if len(names) != 1:
+                    raise MbmError(
+                        f"{os.fspath(archive)}: expected one {problem} {kind} {index}, "
+                        f"found {len(names)}"
+                    )
+                data = tar.extractfile(members[names[0]]).read()
+                found[kind] = (_load(io.BytesIO(data).read(), names[0]), names[0])
+    except (OSError, tarfile.TarError) as err:
+        raise MbmError(f"{os.fspath(archive)}: cannot read the archive: {err}") from None
+    (scene, scene_name), (request, request_name) = found["scene"], found["request"]
+    return _problem(scene, request, scene_name, request_name)
+
+
+def load_mbm_archive(archive: str | os.PathLike) -> dict[tuple[str, int], MbmProblem]:
+    """Every problem of VAMP's ``problems.tar.bz2``, keyed by ``(class, index)``."""
+    texts: dict[tuple[str, int, str], tuple[bytes, str]] = {}
+    try:
+        with tarfile.open(archive) as tar:
+            for member in tar.getmembers():
+                name = member.name.rsplit("/", 2)
+                if not member.isfile() or len(name) < 2 or not name[-1].endswith(".yaml"):
+                    continue
+                folder, file = name[-2], name[-1]
+                problem = next((c for c in MBM_CLASSES if folder.startswith(c + "_")), None)
+                kind = "scene" if file.startswith("scene") else "request"
+                digits = file[len(kind) : -len(".yaml")]
+                if problem is None or not digits.isdigit():
+                    continue
+                texts[problem, int(digits), kind] = (tar.extractfile(member).read(), member.name)
+    except (OSError, tarfile.TarError) as err:
+        raise MbmError(f"{os.fspath(archive)}: cannot read the archive: {err}") from None
+    out = {}
+    for (problem, index, kind), (_, _) in sorted(texts.items()):
+        if kind != "scene" or (problem, index, "request") not in texts:
+            continue
+        (scene, scene_name), (request, request_name) = (
+            texts[problem, index, "scene"],
+            texts[problem, index, "request"],
+        )
+        out[problem, index] = _problem(
+            _load(scene, scene_name), _load(request, request_name), scene_name, request_name
+        )
+    return out
