@@ -30,7 +30,7 @@ def panda(tmp_path_factory):
     cache = tmp_path_factory.mktemp("covers")
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("KCPLAN_CACHE_DIR", str(cache))
-        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf")
+        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=1)
 
 
 def test_the_panda_group_its_limits_and_its_bodies(panda):
@@ -96,7 +96,13 @@ def test_every_mesh_vertex_lies_in_its_links_bodies(panda):
 
 def test_a_group_in_another_order_is_the_state_order(tmp_path, monkeypatch):
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
-    arm = load_arm(PANDA / "panda.urdf", ["panda_joint2", "panda_joint1"])
+    lines = []
+    arm = load_arm(
+        PANDA / "panda.urdf", ["panda_joint2", "panda_joint1"], bodies_per_link=1,
+        progress=lines.append,
+    )  # fmt: skip
+    assert len(lines) == 11 and lines[0].startswith("panda_link0_0: 1 body, fitted in ")
+    assert any("link6" in line and "convex hull" in line for line in lines)
     assert arm.joints == ("panda_joint2", "panda_joint1") and arm.dof == 2
     assert arm.lower.tolist() == pytest.approx([-1.8326, -2.9671])
     frames = joint_frames(arm, [0.3, -0.2])
@@ -129,7 +135,7 @@ def test_a_group_in_another_order_is_the_state_order(tmp_path, monkeypatch):
 )
 def test_bad_groups_are_refused_with_one_line(joints, kwargs, message):
     with pytest.raises(ArmError, match=message) as err:
-        load_arm(PANDA / "panda.urdf", joints, **kwargs)
+        load_arm(PANDA / "panda.urdf", joints, bodies_per_link=1, **kwargs)
     assert "\n" not in str(err.value)
 
 

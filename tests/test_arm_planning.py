@@ -46,7 +46,7 @@ SCENE = [
 def panda(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
-        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf")
+        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=1)
 
 
 @pytest.fixture(scope="module")
