@@ -22,7 +22,8 @@ from kcplan.world import (
 )
 
 ROOT = Path(__file__).resolve().parent.parent
-SUITE = sorted(glob.glob(str(ROOT / "scenarios" / "*" / "*.yaml")))
+# the rigid suite (arm scenarios, scenarios/arm/, have tests of their own: test_arm_cli.py)
+SUITE = sorted(p for p in glob.glob(str(ROOT / "scenarios" / "*" / "*.yaml")) if "/arm/" not in p)
 
 VALID = {
     "name": "t",

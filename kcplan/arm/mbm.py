@@ -31,6 +31,7 @@ from kcplan.world.scenario import Obstacle
 
 __all__ = [
     "MBM_CLASSES",
+    "mbm_scenario",
     "MbmError",
     "MbmProblem",
     "load_mbm_archive",
@@ -101,16 +102,21 @@ def _obstacles(scene: dict, source: str) -> tuple[Obstacle, ...]:
             dims = np.asarray(shape.get("dimensions"), dtype=float)
             if center.shape != (3,) or q.shape != (4,) or not np.isfinite([*center, *q]).all():
                 raise MbmError(f"{source}: {where}: expected a position and a quaternion")
-            R = quaternion_matrix(q / np.linalg.norm(q))
-            spec = {"id": obj.get("id", ""), "type": shape.get("type")}
+            q = q / np.linalg.norm(q)
+            R = quaternion_matrix(q)
+            # spec: the obstacle in kcplan's scenario format (kcplan.arm.scenario)
+            place = {"center": center.tolist(), "quaternion": q.tolist()}
             kind = shape.get("type")
             if kind == "box" and dims.shape == (3,) and (dims > 0).all():
+                spec = {**place, "size": dims.tolist()}
                 out.append(Obstacle("box", len(out), spec, center, R, 0.5 * dims))
             elif kind == "cylinder" and dims.shape == (2,) and (dims > 0).all():
-                height, radius = dims
+                height, radius = (float(d) for d in dims)
+                spec = {**place, "radius": radius, "height": height}
                 extents = np.array([radius, radius, 0.5 * height])
                 out.append(Obstacle("cylinder", len(out), spec, center, R, extents))
             elif kind == "sphere" and dims.shape == (1,) and dims[0] > 0:
+                spec = {"center": center.tolist(), "radius": float(dims[0])}
                 radii = np.full(3, dims[0])
                 out.append(Obstacle("sphere", len(out), spec, center, np.eye(3), radii))
             else:
@@ -234,3 +240,42 @@ def load_mbm_archive(archive: str | os.PathLike) -> dict[tuple[str, int], MbmPro
             _load(scene, scene_name), _load(request, request_name), scene_name, request_name
         )
     return out
+
+
+def mbm_scenario(
+    problem: MbmProblem,
+    name: str,
+    urdf: str | os.PathLike,
+    srdf: str | os.PathLike | None,
+    output: str | os.PathLike,
+    bodies_per_link: int = 4,
+) -> dict:
+    """The arm scenario (:mod:`kcplan.arm.scenario`, as plain data) of one problem: its
+    obstacles, start and goal for the goal's joints, every other joint of the URDF fixed
+    at its start value, and the allowed collision matrix; robot paths relative to the
+    folder of ``output``."""
+    import pinocchio as pin
+
+    folder = Path(output).resolve().parent
+    model = pin.buildModelFromUrdf(os.fspath(urdf))
+    fixed = {
+        joint: value
+        for joint, value in problem.start_state.items()
+        if joint not in problem.joints and model.existJointName(joint)
+    }
+    robot: dict = {"urdf": os.path.relpath(Path(urdf).resolve(), folder)}
+    if srdf is not None:
+        robot["srdf"] = os.path.relpath(Path(srdf).resolve(), folder)
+    robot |= {"joints": list(problem.joints), "bodies_per_link": int(bodies_per_link)}
+    if fixed:
+        robot["fixed"] = fixed
+    return {
+        "name": name,
+        "description": "A MotionBenchMaker problem (KavrakiLab, as VAMP ships it; "
+        "Apache-2.0), converted by kcplan import mbm.",
+        "robot": robot,
+        "start": {"joints": problem.start.tolist()},
+        "goal": {"joints": problem.goal.tolist()},
+        "obstacles": [{o.kind: o.spec} for o in problem.obstacles],
+        "allowed": sorted(sorted(pair) for pair in problem.allowed),
+    }

@@ -93,6 +93,10 @@ class ArmWorld:
         self.clearance_atol = CLEARANCE_ATOL * float(size)
         self.counters = {"collision_queries": 0, "distance_queries": 0}
 
+    def reset_counters(self) -> None:
+        """Set the query counters to zero."""
+        self.counters = dict.fromkeys(self.counters, 0)
+
     def _place(self, state: ArrayLike) -> None:
         q = np.asarray(state, dtype=float)
         if q.shape != (self.arm.dof,) or not np.isfinite(q).all():

@@ -1,11 +1,12 @@
-"""``kcplan import``: convert HRM and Moving AI maps into scenario files."""
+"""``kcplan import``: convert HRM and Moving AI maps, and MotionBenchMaker problems,
+into scenario files."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from kcplan.cli.common import InputError, Parser, output_file, positive_float
+from kcplan.cli.common import InputError, Parser, output_file, positive_float, positive_int
 
 
 def run(args: argparse.Namespace) -> int:
@@ -15,6 +16,8 @@ def run(args: argparse.Namespace) -> int:
 
     out = Path(args.output)
     output_file(args.output, "-o", (".yaml", ".yml"))
+    if args.source == "mbm":
+        return _run_mbm(args, out)
     try:
         if args.source == "hrm":
             from kcplan.maps.hrm import import_hrm
@@ -44,11 +47,51 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_mbm(args: argparse.Namespace, out: Path) -> int:
+    """One MotionBenchMaker problem, from its two files or from the archive."""
+    from kcplan.arm.mbm import MbmError, mbm_scenario, read_mbm_archive, read_mbm_problem
+    from kcplan.world import ScenarioError, dump_scenario, parse_scenario
+
+    files = [args.scene, args.request]
+    try:
+        if args.archive is not None:
+            if any(files) or args.problem is None or args.index is None:
+                raise InputError(
+                    "kcplan import mbm: --archive: expected --problem and --index, and no "
+                    "SCENE.yaml REQUEST.yaml"
+                )
+            problem = read_mbm_archive(args.archive, args.problem, args.index)
+            name = f"{args.problem}_{args.index}"
+        else:
+            if not all(files):
+                raise InputError(
+                    "kcplan import mbm: expected SCENE.yaml REQUEST.yaml, or --archive "
+                    "with --problem and --index"
+                )
+            problem = read_mbm_problem(args.scene, args.request)
+            name = Path(args.scene).stem
+        for option, path in (("--urdf", args.urdf), ("--srdf", args.srdf)):
+            if path is not None and not Path(path).is_file():
+                raise InputError(f"{path}: {option}: expected an existing file")
+        data = mbm_scenario(problem, name, args.urdf, args.srdf, out, args.bodies_per_link)
+        scenario = parse_scenario(data, str(out), out.parent, check=True)
+    except (MbmError, ScenarioError) as err:
+        raise InputError(str(err)) from None
+    dump_scenario(data, out)
+    print(
+        f"{out}: {scenario.name}, arm of {scenario.arm.dof} joints "
+        f"({len(scenario.arm.bodies)} bodies), {len(scenario.obstacles)} obstacles, "
+        f"{len(scenario.allowed)} allowed link pairs"
+    )
+    return 0
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``kcplan import`` on the subcommand parsers ``sub``."""
     p = sub.add_parser(
         "import",
-        help="convert public benchmark maps (HRM, Moving AI) into scenario files",
+        help="convert public benchmark maps (HRM, Moving AI) and MotionBenchMaker problems "
+        "into scenario files",
         description="Convert a public benchmark map into a kcplan scenario YAML; the "
         "result is validated (start and goal free) before it is written.",
     )
@@ -91,5 +134,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="robot semi-axes (default 0.7 and 0.4 times the narrowest corridor)",
     )
     q.add_argument("--inflation", type=positive_float, default=0.1, help="guard inflation")
+    q.add_argument("-o", "--output", required=True, metavar="SCENARIO.yaml")
+    q.set_defaults(handler=run)
+    q = kinds.add_parser(
+        "mbm",
+        help="a MotionBenchMaker problem (MoveIt scene and request YAML) for a URDF arm",
+        description="Convert one MotionBenchMaker problem into an arm scenario: its "
+        "obstacles, the request's start and goal for the goal's joints (the planning "
+        "group), every other joint fixed at its start value, the scene's allowed collision "
+        "matrix. The start and goal must be free for the covered arm.",
+    )
+    q.add_argument("scene", nargs="?", metavar="SCENE.yaml")
+    q.add_argument("request", nargs="?", metavar="REQUEST.yaml")
+    q.add_argument("--archive", metavar="problems.tar.bz2", help="VAMP's problem archive")
+    q.add_argument("--problem", help="with --archive: the class, e.g. box or bookshelf_tall")
+    q.add_argument("--index", type=positive_int, help="with --archive: the problem, 1 to 100")
+    q.add_argument("--urdf", required=True, metavar="ROBOT.urdf")
+    q.add_argument("--srdf", metavar="ROBOT.srdf")
+    q.add_argument("--bodies-per-link", type=positive_int, default=4)
     q.add_argument("-o", "--output", required=True, metavar="SCENARIO.yaml")
     q.set_defaults(handler=run)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from kcplan.cli.common import load_input, output_file, planner_name, positive_float
+from kcplan.cli.common import InputError, load_input, output_file, planner_name, positive_float
 
 
 def _print_counters(counters: dict) -> None:
@@ -31,6 +31,10 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.animate, "--animate", (".gif",))
     output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
+    if getattr(scenario, "arm", None) is not None:
+        for option in ("plot", "animate", "html"):
+            if getattr(args, option):
+                raise InputError(f"{args.scenario}: --{option}: not available for arms yet")
     from kcplan.planning.problem import plan
 
     result = plan(scenario, args.planner, args.time, args.seed, args.simplify)

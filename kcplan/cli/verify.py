@@ -12,6 +12,8 @@ from kcplan.cli.common import InputError, load_input, positive_float
 
 
 def _read_path(path: str, scenario) -> np.ndarray:
+    """The path file's states, checked against the scenario (poses, or an arm's joint
+    vectors in its ``joints`` order)."""
     try:
         data = json.loads(Path(path).read_text())
     except OSError as err:
@@ -20,15 +22,22 @@ def _read_path(path: str, scenario) -> np.ndarray:
         raise InputError(f"{path}: expected a JSON path file, got invalid JSON ({err})") from None
     if not isinstance(data, dict) or "states" not in data:
         raise InputError(f"{path}: states: expected a JSON object with a 'states' list")
-    width = 3 if scenario.dimension == 2 else 7
+    arm = getattr(scenario, "arm", None)
+    if arm is not None and data.get("joints") != list(arm.joints):
+        raise InputError(
+            f"{path}: joints: expected the scenario's planning group {list(arm.joints)}, "
+            f"got {data.get('joints')!r}"
+        )
+    width = arm.dof if arm is not None else 3 if scenario.dimension == 2 else 7
     try:
         states = np.array(data["states"], dtype=float)
     except (TypeError, ValueError):
         states = np.zeros((0, 0))
     if states.ndim != 2 or states.shape[1] != width or len(states) < 1:
+        what = "joint vectors" if arm is not None else "poses"
         raise InputError(
-            f"{path}: states: expected a non-empty list of poses with {width} numbers each "
-            f"(scenario {scenario.source} is {scenario.dimension}D)"
+            f"{path}: states: expected a non-empty list of {what} with {width} numbers each "
+            f"(scenario {scenario.source})"
         )
     if not np.isfinite(states).all():
         raise InputError(f"{path}: states: expected finite numbers")
@@ -47,6 +56,8 @@ def run(args: argparse.Namespace) -> int:
     """Verify the path file against the scenario; exit 1 on a collision."""
     scenario = load_input(args.scenario)
     states = _read_path(args.path, scenario)
+    if getattr(scenario, "arm", None) is not None:
+        return _verify_arm(args, scenario, states)
     from kcplan.planning.verify import verify_path
     from kcplan.world import CollisionWorld
 
@@ -69,6 +80,30 @@ def run(args: argparse.Namespace) -> int:
         "clearance "
         f"{check.min_clearance:.6g}, {check.queries} clearance queries"
     )
+    return 0
+
+
+def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
+    """An arm's path, on the links' own collision meshes (:mod:`kcplan.arm.verify`)."""
+    from kcplan.arm.verify import verify_arm_path
+
+    if args.mesh is not None:
+        raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
+    outside = [k for k, q in enumerate(states) if not scenario.arm.within_limits(q)]
+    if outside:
+        raise InputError(f"{args.path}: states[{outside[0]}]: expected joint values within "
+                         "the limits")  # fmt: skip
+    check = verify_arm_path(
+        scenario.arm, scenario.obstacles, states, args.tolerance, allowed=scenario.allowed
+    )
+    if check.collides:
+        edge, s = check.where
+        print(f"COLLISION of the links' meshes on edge {edge} at s = {s:.6f} "
+              f"({check.queries} distance queries)")  # fmt: skip
+        return 1
+    edges = max(len(states) - 1, 1)
+    print(f"clean: the links' meshes, {edges} edges checked without gaps, minimum "
+          f"clearance {check.min_clearance:.6g}, {check.queries} distance queries")  # fmt: skip
     return 0
 
 

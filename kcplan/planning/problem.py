@@ -10,16 +10,20 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from kcplan.arm.scenario import ArmScenario
+from kcplan.arm.verify import verify_arm_path
+from kcplan.arm.world import ArmWorld
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, STOCK, check_planner_name
 from kcplan.planning.progress import ProgressRecorder, reports_progress
-from kcplan.planning.states import set_state, state_pose, state_space
+from kcplan.planning.states import joint_state, set_state, state_pose, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
 from kcplan.world.collision import CollisionWorld
@@ -222,6 +226,9 @@ class PlanResult:
     """Seconds into ``solve()`` of the first exact solution, when progress was recorded."""
     backend: str = "kernel"
     """Who checked: ``"kernel"`` (compiled, coal) or ``"python"`` (python-fcl)."""
+    joints: tuple[str, ...] | None = None
+    """An arm's planning group: ``states`` are joint vectors in this order (else None:
+    flat poses)."""
 
     def verify(self, tolerance: float = 1e-6) -> PathCheck:
         """Check the path without gaps, independently of every certificate
@@ -235,15 +242,20 @@ class PlanResult:
         """
         if not self.solved or self.problem is None:
             raise ValueError(f"verify: expected a solved plan, got {self.planner} not solved")
+        if isinstance(self.problem, ArmScenario):
+            p = self.problem
+            return verify_arm_path(p.arm, p.obstacles, self.states, tolerance, allowed=p.allowed)
         return verify_path(CollisionWorld(self.problem), self.states, tolerance)
 
     def to_json(self) -> dict:
-        """The ``PATH.json`` document of ``kcplan plan``."""
+        """The ``PATH.json`` document of ``kcplan plan`` (an arm's has ``joints``)."""
+        joints = {} if self.joints is None else {"joints": list(self.joints)}
         return {
             "scenario": self.scenario,
             "planner": self.planner,
             "solved": self.solved,
             "dimension": self.dimension,
+            **joints,
             "states": self.states,
             "length": self.length,
             "raw_length": self.raw_length,
@@ -308,43 +320,23 @@ def plan(
     spec = PLANNERS[planner]
     if seed is not None:
         seed_ompl(seed)
-    n = scenario.dimension
-    world = world or CollisionWorld(scenario)
-    world.reset_counters()
-    space = state_space(*scenario.bounds)
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
     checker_calls = [0]
-    validator = None
-    if spec.kc:
-        validator = KCMotionValidator(
-            si,
-            world.robot,
-            world,
-            spec.certificates,
-            spec.fallback,
-            backend=spec.backend,
-            probes=spec.probes,
-        )
-        si.setMotionValidator(validator)
-        state_valid = validator.state_valid  # shares the validator's guard cache
-    elif spec.backend == "kernel":
-        state_valid = _kernel_checker(world.kernel, n)
+    if isinstance(scenario, ArmScenario):
+        setup = _arm_setup(scenario, spec, world)
     else:
-
-        def state_valid(state) -> bool:
-            return not world.in_collision(state_pose(state, n))
+        setup = _rigid_setup(scenario, spec, world)
+    space, ss, si, validator = setup.space, setup.ss, setup.si, setup.validator
 
     def is_valid(state) -> bool:
         checker_calls[0] += 1
-        return state_valid(state)
+        return setup.state_valid(state)
 
     si.setStateValidityChecker(is_valid)
     if spec.resolution is not None:
         si.setStateValidityCheckingResolution(spec.resolution)
     start, goal = si.allocState(), si.allocState()
-    set_state(start, scenario.start, n)
-    set_state(goal, scenario.goal, n)
+    setup.write(start, scenario.start)
+    setup.write(goal, scenario.goal)
     ss.setStartAndGoalStates(start, goal)
     planner_object = spec.make(si)
     ss.setPlanner(planner_object)
@@ -383,14 +375,13 @@ def plan(
                     validator.raise_error()
                 simplify_time = time.perf_counter() - t0
             path = ss.getSolutionPath()
-            states = [state_pose(s, n).tolist() for s in path.getStates()]
+            states = [setup.read(s).tolist() for s in path.getStates()]
             length = float(path.length())
             del path
+        queries = setup.world.counters
         counters = {
-            **world.counters,
-            "fcl_queries": world.counters["collision_queries"]
-            + world.counters["distance_queries"]
-            + world.counters["region_queries"],
+            **queries,
+            "fcl_queries": sum(queries.get(k, 0) for k in _QUERY_KINDS),
             "checker_calls": checker_calls[0],
         }
         if validator is not None:
@@ -401,7 +392,7 @@ def plan(
     return PlanResult(
         scenario.name,
         planner,
-        n,
+        scenario.dimension,
         solved,
         solve_time,
         simplify_time,
@@ -413,5 +404,95 @@ def plan(
         scenario,
         recorder.to_json() if recorder is not None else {},
         recorder.first_solution_time if recorder is not None else None,
-        spec.backend,
+        "python" if isinstance(scenario, ArmScenario) else spec.backend,
+        scenario.arm.joints if isinstance(scenario, ArmScenario) else None,
     )
+
+
+_QUERY_KINDS = ("collision_queries", "distance_queries", "region_queries")
+
+
+@dataclass
+class _Setup:
+    """What :func:`plan` needs of a problem: the OMPL setup, the validator (kc planners),
+    the state validity check and how states are read and written."""
+
+    space: object
+    ss: object
+    si: object
+    world: object
+    validator: KCMotionValidator | None
+    state_valid: Callable
+    read: Callable
+    write: Callable
+
+
+def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | None) -> _Setup:
+    """SE(2) or SE(3) within the bounds; the kernel's (or python-fcl's) collision query."""
+    n = scenario.dimension
+    world = world or CollisionWorld(scenario)
+    world.reset_counters()
+    space = state_space(*scenario.bounds)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    validator = None
+    if spec.kc:
+        validator = KCMotionValidator(
+            si,
+            world.robot,
+            world,
+            spec.certificates,
+            spec.fallback,
+            backend=spec.backend,
+            probes=spec.probes,
+        )
+        si.setMotionValidator(validator)
+        state_valid = validator.state_valid  # shares the validator's guard cache
+    elif spec.backend == "kernel":
+        state_valid = _kernel_checker(world.kernel, n)
+    else:
+
+        def state_valid(state) -> bool:
+            return not world.in_collision(state_pose(state, n))
+
+    return _Setup(
+        space, ss, si, world, validator, state_valid,
+        lambda state: state_pose(state, n), lambda state, pose: set_state(state, pose, n),
+    )  # fmt: skip
+
+
+def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
+    """The group's joint box (the limits); the covers' python-fcl queries. For arms the
+    ``kc-*`` and ``ca-*`` planners both certify with the chain's clearance balls
+    (:mod:`kcplan.planning.arm_certifier`); stock planners check states discretely."""
+    arm = scenario.arm
+    if world is None:
+        world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
+    world.reset_counters()
+    space = ob.RealVectorStateSpace(arm.dof)
+    bounds = ob.RealVectorBounds(arm.dof)
+    for j in range(arm.dof):
+        bounds.setLow(j, float(arm.lower[j]))
+        bounds.setHigh(j, float(arm.upper[j]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    si = ss.getSpaceInformation()
+    validator = None
+    if spec.kc:
+        validator = KCMotionValidator(si, arm, world)
+        si.setMotionValidator(validator)
+        state_valid = validator.state_valid
+    else:
+
+        def state_valid(state) -> bool:
+            q = joint_state(state, arm.dof)
+            return arm.within_limits(q) and not world.in_collision(q)
+
+    def write(state, q) -> None:
+        for j, value in enumerate(q):
+            state[j] = float(value)
+
+    return _Setup(
+        space, ss, si, world, validator, state_valid,
+        lambda state: joint_state(state, arm.dof), write,
+    )  # fmt: skip

@@ -22,6 +22,17 @@ __all__ = ["check_start_goal", "load_scenario", "parse_scenario"]
 def check_start_goal(scenario: Scenario) -> None:
     """Raise :class:`ScenarioError` naming the obstacles the robot touches at the start or
     the goal (``FILE: start: the robot collides with obstacles[3] (box)``)."""
+    if not isinstance(scenario, Scenario):  # an arm
+        from kcplan.arm.world import ArmWorld
+
+        arm_world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)
+        for key, q in (("start", scenario.start), ("goal", scenario.goal)):
+            if arm_world.in_collision(q):
+                raise ScenarioError(
+                    f"{scenario.source}: {key}: the arm's cover touches an obstacle or "
+                    "itself (more bodies per link may free it: robot.bodies_per_link)"
+                )
+        return
     world = CollisionWorld(scenario)
     for key, pose in (("start", scenario.start), ("goal", scenario.goal)):
         hits = world.colliding_obstacles(pose)

@@ -461,6 +461,10 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
     """
     r = _Reader(source)
     directory = Path.cwd() if directory is None else directory
+    if isinstance(data, dict) and isinstance(data.get("robot"), dict) and "urdf" in data["robot"]:
+        from kcplan.arm.scenario import parse_arm_scenario  # an arm: its own format
+
+        return parse_arm_scenario(data, source, directory)
     top = r.mapping(
         data,
         "top level",
@@ -569,7 +573,9 @@ def as_scenario(value: Scenario | str | os.PathLike) -> Scenario:
     ScenarioError
         For a path whose file is not a valid scenario.
     """
-    if isinstance(value, Scenario):
+    from kcplan.arm.scenario import ArmScenario
+
+    if isinstance(value, (Scenario, ArmScenario)):
         return value
     if isinstance(value, (str, os.PathLike)):
         return load_scenario(value)
@@ -605,9 +611,16 @@ def scenario_to_dict(scenario: Scenario) -> dict:
     return out
 
 
-def dump_scenario(scenario: Scenario | dict, path: str | os.PathLike) -> None:
+def dump_scenario(scenario, path: str | os.PathLike) -> None:
     """Write a scenario (or its dict) as YAML, atomically (temporary file, then rename)."""
-    data = scenario if isinstance(scenario, dict) else scenario_to_dict(scenario)
+    if isinstance(scenario, dict):
+        data = scenario
+    elif isinstance(scenario, Scenario):
+        data = scenario_to_dict(scenario)
+    else:
+        from kcplan.arm.scenario import arm_scenario_to_dict
+
+        data = arm_scenario_to_dict(scenario)
     write_text_atomic(
         path, yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
     )

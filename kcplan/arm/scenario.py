@@ -1,0 +1,191 @@
+"""Scenario files of arms: a URDF robot, its planning group, start, goal and scene.
+
+The format (``scenarios/README.md``)::
+
+    name: box_1
+    robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,
+            joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
+            bodies_per_link: 4, inflation: 0.0}
+    start: {joints: [...]}            # the group's values, in ``joints`` order
+    goal: {joints: [...]}
+    obstacles: [{box: {center, size, quaternion}}, {cylinder: {center, quaternion,
+                 radius, height}}, {sphere: ...}, {ellipsoid: ...}, {convex: ...},
+                 {mesh: ...}]
+    allowed: [[LINK, LINK], ...]      # link pairs allowed to touch (MoveIt's ACM)
+
+Paths are relative to the scenario file. ``joints`` is the planning group in state
+order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`). A
+cylinder's axis is its local z. ``inflation`` is kept for the KC certificate of arms
+(to come); the clearance-ball certificate does not use it. Every field is validated with
+the rigid format's one-line errors (:class:`kcplan.world.scenario.ScenarioError`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kcplan.arm.model import ArmError, ArmModel, load_arm
+from kcplan.world.scenario import (
+    MAX_OBSTACLES,
+    Obstacle,
+    ScenarioError,
+    _obstacle,
+    _Reader,
+)
+
+__all__ = ["ArmScenario", "arm_scenario_to_dict", "parse_arm_scenario"]
+
+
+@dataclass(frozen=True, eq=False)
+class ArmScenario:
+    """A validated planning problem for an arm (see the module docstring).
+
+    ``start`` and ``goal`` are joint vectors in ``arm.joints`` order; ``bounds`` are the
+    joint limits, shape ``(2, dof)``.
+    """
+
+    name: str
+    arm: ArmModel
+    start: NDArray[np.float64]
+    goal: NDArray[np.float64]
+    obstacles: tuple[Obstacle, ...]
+    allowed: frozenset
+    robot_spec: dict
+    inflation: float = 0.0
+    description: str = ""
+    source: str = "<string>"
+    directory: Path = field(default_factory=Path.cwd)
+    dimension = 3
+
+    @property
+    def bounds(self) -> NDArray[np.float64]:
+        return np.stack([self.arm.lower, self.arm.upper])
+
+    @property
+    def robot(self) -> ArmModel:
+        return self.arm
+
+
+def _cylinder(r: _Reader, spec: Any, index: int) -> Obstacle:
+    where = f"obstacles[{index}].cylinder"
+    spec = r.mapping(spec, where, ("center", "radius", "height"), ("quaternion",))
+    center = r.vector(spec["center"], f"{where}.center", 3)
+    radius = r.number(spec["radius"], f"{where}.radius", positive=True)
+    height = r.number(spec["height"], f"{where}.height", positive=True)
+    R = r.rotation(spec, where, 3)
+    return Obstacle("cylinder", index, spec, center, R, np.array([radius, radius, 0.5 * height]))
+
+
+def _joints(r: _Reader, value: Any, where: str, arm: ArmModel) -> NDArray[np.float64]:
+    spec = r.mapping(value, where, ("joints",))
+    q = r.vector(spec["joints"], f"{where}.joints", arm.dof)
+    if not arm.within_limits(q):
+        outside = [
+            f"{name} {v:.4g} not in [{lo:.4g}, {hi:.4g}]"
+            for name, v, lo, hi in zip(arm.joints, q, arm.lower, arm.upper, strict=True)
+            if not lo <= v <= hi
+        ]
+        r.fail(f"{where}.joints", "joint values within the URDF's limits", q.tolist(),
+               "; ".join(outside))  # fmt: skip
+    return q
+
+
+def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
+    """Validate parsed YAML of an arm scenario and load its robot.
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the source, the field and what was expected.
+    """
+    r = _Reader(source)
+    top = r.mapping(
+        data, "top level", ("name", "robot", "start", "goal"),
+        ("dimension", "description", "obstacles", "allowed"),
+    )  # fmt: skip
+    name = r.text(top["name"], "name")
+    description = top.get("description", "")
+    if not isinstance(description, str):
+        r.fail("description", "a string", description)
+    if "dimension" in top and (isinstance(top["dimension"], bool) or top["dimension"] != 3):
+        r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
+    spec = r.mapping(
+        top["robot"], "robot", ("urdf", "joints"),
+        ("srdf", "fixed", "bodies_per_link", "inflation"),
+    )  # fmt: skip
+    urdf = directory / r.text(spec["urdf"], "robot.urdf")
+    srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
+    for key, path in (("urdf", urdf), ("srdf", srdf)):
+        if path is not None and not path.is_file():
+            r.fail(f"robot.{key}", f"an existing {key.upper()} file (relative to the scenario)",
+                   None, f"{spec[key]!r}, which does not exist at {path}")  # fmt: skip
+    joints = spec["joints"]
+    if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
+        r.fail("robot.joints", "a list of joint names", joints)
+    fixed = spec.get("fixed", {}) or {}
+    if not isinstance(fixed, dict):
+        r.fail("robot.fixed", "a mapping of joint names to values", fixed)
+    fixed = {str(k): r.number(v, f"robot.fixed.{k}") for k, v in fixed.items()}
+    bodies = spec.get("bodies_per_link", 4)
+    if isinstance(bodies, bool) or not isinstance(bodies, int) or not 1 <= bodies <= 32:
+        r.fail("robot.bodies_per_link", "an integer from 1 to 32", bodies)
+    inflation = r.number(spec.get("inflation", 0.0), "robot.inflation")
+    if inflation < 0:
+        r.fail("robot.inflation", "a number >= 0", inflation)
+    try:
+        arm = load_arm(urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies)
+    except ArmError as err:
+        raise ScenarioError(f"{source}: robot: {err}") from None
+    start, goal = (_joints(r, top[key], key, arm) for key in ("start", "goal"))
+    items = top.get("obstacles") or []
+    if not isinstance(items, list):
+        r.fail("obstacles", "a list of obstacles", items)
+    if len(items) > MAX_OBSTACLES:
+        r.fail("obstacles", f"at most {MAX_OBSTACLES} obstacles", None, f"{len(items)}")
+    obstacles = []
+    for i, item in enumerate(items):
+        if isinstance(item, dict) and len(item) == 1 and "cylinder" in item:
+            obstacles.append(_cylinder(r, item["cylinder"], i))
+        else:
+            obstacles.append(_obstacle(r, item, i, 3, directory))
+    allowed = _allowed(r, top.get("allowed") or [])
+    return ArmScenario(
+        name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
+        description, source, directory,
+    )  # fmt: skip
+
+
+def _allowed(r: _Reader, value: Any) -> frozenset:
+    """Link pairs allowed to touch; names outside the robot are kept (MoveIt's matrix
+    lists the scene's objects too)."""
+    if not isinstance(value, list):
+        r.fail("allowed", "a list of link pairs [LINK, LINK]", value)
+    pairs = set()
+    for k, pair in enumerate(value):
+        if not (isinstance(pair, list) and len(pair) == 2 and all(map(_is_text, pair))):
+            r.fail(f"allowed[{k}]", "a pair of link names [LINK, LINK]", pair)
+        pairs.add(frozenset(pair))
+    return frozenset(pairs)
+
+
+def _is_text(value: Any) -> bool:
+    return isinstance(value, str)
+
+
+def arm_scenario_to_dict(scenario: ArmScenario) -> dict:
+    """The scenario as plain data in the file format."""
+    out: dict = {"name": scenario.name}
+    if scenario.description:
+        out["description"] = scenario.description
+    out["robot"] = scenario.robot_spec
+    out["start"] = {"joints": scenario.start.tolist()}
+    out["goal"] = {"joints": scenario.goal.tolist()}
+    out["obstacles"] = [{o.kind: o.spec} for o in scenario.obstacles]
+    if scenario.allowed:
+        out["allowed"] = sorted(sorted(pair) for pair in scenario.allowed)
+    return out
