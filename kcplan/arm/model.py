@@ -137,6 +137,10 @@ class ArmModel:
         """Number of joints in the planning group (the state's length)."""
         return len(self.joints)
 
+    def describe(self) -> str:
+        """One line for reports: ``arm of 7 joints, 44 bodies (panda.urdf)``."""
+        return f"arm of {self.dof} joints, {len(self.bodies)} bodies ({Path(self.urdf).name})"
+
     def configuration(self, state: Sequence[float]) -> NDArray[np.float64]:
         """The reduced model's configuration vector of a state ``(dof,)`` (joint values in
         :attr:`joints` order)."""

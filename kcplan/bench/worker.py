@@ -40,7 +40,9 @@ def execute(spec: dict) -> dict:
     from kcplan.world import CollisionWorld, load_scenario
 
     scenario = load_scenario(spec["scenario"])
-    world = CollisionWorld(scenario)  # plan() resets its counters and copies them out
+    arm = getattr(scenario, "arm", None) is not None
+    # plan() resets the world's counters and copies them out
+    world = None if arm else CollisionWorld(scenario)
     result = plan(
         scenario,
         spec["planner"],
@@ -50,9 +52,11 @@ def execute(spec: dict) -> dict:
         world=world,
         progress=spec.get("progress"),
     )
-    check = verify_path(world, result.states) if result.solved else None
+    check = None
+    if result.solved:  # an arm on its links' meshes (PlanResult.verify)
+        check = result.verify() if arm else verify_path(world, result.states)
     part = None
-    if check is not None and scenario.part is not None:
+    if check is not None and not arm and scenario.part is not None:
         from kcplan.world.part import PartWorld
 
         part = verify_path(PartWorld(world, scenario.part), result.states)
