@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan.arm.bounds import carries, point_speeds
-from kcplan.planning.certifier import COUNTER_NAMES
+from kcplan.planning.certifier import COUNTER_NAMES, advance
 
 __all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier"]
 
@@ -160,28 +160,14 @@ class ArmEdgeCertifier:
         return self._advance(q1, q2, lo, hi, speed, pair_speed)
 
     def _advance(self, q1, q2, lo, hi, speed, pair_speed) -> bool:
-        c = self.counters
-        pending = [(lo, hi)]
-        guards = 0
-        while pending:
-            s0, s1 = pending.pop()
-            if guards >= self.max_guards:
-                c["bisection_nodes"] += guards
-                return self._reject("not_proven")
-            m = 0.5 * (s0 + s1)
+        def reach(m: float, s0: float, s1: float) -> tuple[float, float] | None:
             r = self._radius(self._measure(q1 + m * (q2 - q1)), speed, pair_speed)
-            guards += 1
-            if r <= 0.0:
-                c["bisection_nodes"] += guards
-                return self._reject("rejected_guard")
-            if r <= 1e-12:
-                c["bisection_nodes"] += guards
-                return self._reject("not_proven")
-            if m - r > s0:
-                pending.append((s0, m - r))
-            if m + r < s1:
-                pending.append((m + r, s1))
-        c["bisection_nodes"] += guards
-        c["certified_one_guard"] += guards == 1
+            return None if r <= 0.0 else (m - r, m + r)
+
+        reason, guards = advance(lo, hi, self.max_guards, reach)
+        self.counters["bisection_nodes"] += guards
+        if reason is not None:
+            return self._reject(reason)
+        self.counters["certified_one_guard"] += guards == 1
         self.covered["ball"] += 1.0
         return True

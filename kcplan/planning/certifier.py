@@ -8,7 +8,7 @@ import OMPL (:class:`kcplan.planning.validator.KCMotionValidator` is the thin ad
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -28,6 +28,7 @@ from kcplan.world.occupancy import CoreOccupancy
 
 __all__ = [
     "CERTIFICATE_SETS",
+    "advance",
     "COUNTER_NAMES",
     "DEFAULT_PROBES",
     "EdgeCertifier",
@@ -399,30 +400,18 @@ class EdgeCertifier:
         return True
 
     def _advance(self, edge: Edge, lo: float, hi: float) -> bool:
-        c = self.counters
-        pending = [(lo, hi)]
-        guards = 0
-        while pending:
-            s0, s1 = pending.pop()
-            if guards >= self.max_guards:
-                c["bisection_nodes"] += guards
-                return self._reject("not_proven")
-            m = 0.5 * (s0 + s1)
+        def reach(m: float, s0: float, s1: float) -> tuple[float, float] | None:
             guard = self.measure(edge.pose(m))
-            guards += 1
-            if guard.clearance <= 0.0:
-                c["bisection_nodes"] += guards
-                return self._reject("rejected_guard")
-            g_lo, g_hi = self._reach(guard, edge, m, s0, s1)
-            if g_hi - g_lo <= 1e-12:
-                c["bisection_nodes"] += guards
-                return self._reject("not_proven")
-            if g_lo > s0:
-                pending.append((s0, g_lo))
-            if g_hi < s1:
-                pending.append((g_hi, s1))
-        c["bisection_nodes"] += guards
-        c["certified_one_guard"] += guards == 1
+            return None if guard.clearance <= 0.0 else self._reach(guard, edge, m, s0, s1)
+
+        return self._decide(*advance(lo, hi, self.max_guards, reach))
+
+    def _decide(self, reason: str | None, guards: int) -> bool:
+        """Count an advancement's guards and its outcome (:func:`advance`)."""
+        self.counters["bisection_nodes"] += guards
+        if reason is not None:
+            return self._reject(reason)
+        self.counters["certified_one_guard"] += guards == 1
         return True
 
     def _sample(self, edge: Edge, resolution: float, lo: float, hi: float) -> bool:
@@ -435,6 +424,43 @@ class EdgeCertifier:
             if self.world.in_collision(edge.pose(s)):
                 return self._reject("rejected_guard")
         return True
+
+
+def advance(
+    lo: float,
+    hi: float,
+    max_guards: int,
+    reach: Callable[[float, float, float], tuple[float, float] | None],
+) -> tuple[str | None, int]:
+    """Conservative advancement over ``[lo, hi]``: a guard at the middle ``m`` of each
+    stretch ``[s0, s1]`` left open, until none is.
+
+    ``reach(m, s0, s1)`` measures the guard at ``m`` and returns the stretch ``(g_lo,
+    g_hi)`` around ``m`` it proves free, or None when the guard touches an obstacle.
+    Returns ``(reason, guards)``: reason None (covered), ``"rejected_guard"`` (a guard
+    touched an obstacle) or ``"not_proven"`` (``max_guards`` placed, or a guard that
+    proves nothing), and the number of guards placed. The rigid and the arm certifiers
+    advance by it; the compiled twin is ``EdgeCertifier::advance``.
+    """
+    pending = [(lo, hi)]
+    guards = 0
+    while pending:
+        s0, s1 = pending.pop()
+        if guards >= max_guards:
+            return "not_proven", guards
+        m = 0.5 * (s0 + s1)
+        stretch = reach(m, s0, s1)
+        guards += 1
+        if stretch is None:
+            return "rejected_guard", guards
+        g_lo, g_hi = stretch
+        if g_hi - g_lo <= 1e-12:
+            return "not_proven", guards
+        if g_lo > s0:
+            pending.append((s0, g_lo))
+        if g_hi < s1:
+            pending.append((g_hi, s1))
+    return None, guards
 
 
 def probe_points(count: int) -> list[float]:
