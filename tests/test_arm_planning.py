@@ -13,6 +13,7 @@ from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
+from kcplan.planning.states import joint_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.world import parse_scenario
 
@@ -117,13 +118,7 @@ def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
     """OMPL's RRT-Connect on the group's joint box with KCMotionValidator(si, arm, world):
     the path is free on the meshes, without gaps."""
     world, obstacles = scene
-    space = ob.RealVectorStateSpace(panda.dof)
-    bounds = ob.RealVectorBounds(panda.dof)
-    for j in range(panda.dof):
-        bounds.setLow(j, float(panda.lower[j]))
-        bounds.setHigh(j, float(panda.upper[j]))
-    space.setBounds(bounds)
-    si = ob.SpaceInformation(space)
+    si = ob.SpaceInformation(joint_space(panda.lower, panda.upper))
     mv = KCMotionValidator(si, panda, world)
     si.setMotionValidator(mv)
     si.setStateValidityChecker(mv.state_valid)

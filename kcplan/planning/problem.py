@@ -23,7 +23,13 @@ from kcplan.arm.world import ArmWorld
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, STOCK, check_planner_name
 from kcplan.planning.progress import ProgressRecorder, reports_progress
-from kcplan.planning.states import joint_state, set_state, state_pose, state_space
+from kcplan.planning.states import (
+    joint_space,
+    joint_state,
+    set_state,
+    state_pose,
+    state_space,
+)
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
 from kcplan.world.collision import CollisionWorld
@@ -469,12 +475,7 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     if world is None:
         world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
     world.reset_counters()
-    space = ob.RealVectorStateSpace(arm.dof)
-    bounds = ob.RealVectorBounds(arm.dof)
-    for j in range(arm.dof):
-        bounds.setLow(j, float(arm.lower[j]))
-        bounds.setHigh(j, float(arm.upper[j]))
-    space.setBounds(bounds)
+    space = joint_space(arm.lower, arm.upper)
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     validator = None

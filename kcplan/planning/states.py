@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
-__all__ = ["state_space", "state_pose", "set_state"]
+__all__ = ["joint_space", "joint_state", "set_state", "state_pose", "state_space"]
 
 
 def state_space(low: ArrayLike, high: ArrayLike) -> ob.StateSpace:
@@ -32,6 +32,19 @@ def state_pose(state, n: int) -> np.ndarray:
         return np.array([state.getX(), state.getY(), state.getYaw()])
     r = state.rotation()
     return np.array([state.getX(), state.getY(), state.getZ(), r.x, r.y, r.z, r.w])
+
+
+def joint_space(lower: ArrayLike, upper: ArrayLike) -> ob.RealVectorStateSpace:
+    """The joint box of an arm's planning group: a ``RealVectorStateSpace`` with bounds
+    ``lower``, ``upper`` (shape ``(dof,)``, the joint limits)."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    space = ob.RealVectorStateSpace(len(lower))
+    bounds = ob.RealVectorBounds(len(lower))
+    for j, (low, high) in enumerate(zip(lower, upper, strict=True)):
+        bounds.setLow(j, float(low))
+        bounds.setHigh(j, float(high))
+    space.setBounds(bounds)
+    return space
 
 
 def joint_state(state, dof: int) -> np.ndarray:
