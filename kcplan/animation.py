@@ -51,7 +51,7 @@ def animate_path(
     int
         The number of frames written.
     """
-    scenario = as_scenario(scenario)
+    scenario = as_scenario(scenario, rigid=True)
     n = scenario.dimension
     poses = path_poses(states, n, max(frames - 1, 1))
     fig, ax = scenario_axes(scenario)

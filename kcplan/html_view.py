@@ -98,7 +98,7 @@ def scene_figure(
     """The scene (a scenario, or the path of its file; and the path ``states``, shape
     ``(k, 3 or 7)``, with the robot moving along it in about ``frames`` steps) as a
     plotly figure."""
-    scenario = as_scenario(scenario)
+    scenario = as_scenario(scenario, rigid=True)
     n = scenario.dimension
     traces = []
     for ob in scenario.obstacles:

@@ -288,7 +288,7 @@ def plot_scenario(
 ) -> None:
     """Draw a scenario (or the scenario file at a path; 2D top view or 3D perspective)
     into an image file."""
-    scenario = as_scenario(scenario)
+    scenario = as_scenario(scenario, rigid=True)
     fig, ax = scenario_axes(scenario)
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
@@ -322,7 +322,7 @@ def plot_path(
     """Draw a scenario with a path: its centre line, the robot at intervals along it and,
     if given, guards as ``(pose, inflation)`` pairs (dashed); ``scenario`` may be the
     path of a scenario file."""
-    scenario = as_scenario(scenario)
+    scenario = as_scenario(scenario, rigid=True)
     n = scenario.dimension
     poses = path_poses(states, n) if len(states) else []
     fig, ax = scenario_axes(scenario)

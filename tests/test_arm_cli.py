@@ -208,3 +208,17 @@ def test_bench_runs_and_verifies_arm_planners(tmp_path, capsys):
     assert "2 of 2 runs finished: 2 solved, 0 failed, 0 returned paths collide" in printed
     records = [json.loads(line) for line in (out / "runs.jsonl").read_text().splitlines()]
     assert all(r["collides"] is False and r["verify_queries"] > 0 for r in records)
+
+
+def test_the_views_and_the_rigid_world_refuse_arms_with_one_line(capsys):
+    from kcplan.viz import plot_scenario
+    from kcplan.world import CollisionWorld
+
+    box = ARM / "box_1.yaml"
+    assert main(["show", str(box)]) == 2
+    assert capsys.readouterr().err.strip() == f"{box}: show: arms are not drawn yet"
+    for call in (lambda: plot_scenario(box, "x.png"), lambda: CollisionWorld(box)):
+        with pytest.raises(TypeError, match="expected a rigid robot of ellipsoids, got an arm"):
+            call()
+    assert main(["validate", str(box)]) == 0
+    assert "robot arm of 7 joints, 44 bodies (panda.urdf)" in capsys.readouterr().out

@@ -22,6 +22,7 @@ the rigid format's one-line errors (:class:`kcplan.world.scenario.ScenarioError`
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -138,7 +139,9 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     if inflation < 0:
         r.fail("robot.inflation", "a number >= 0", inflation)
     try:
-        arm = load_arm(urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies)
+        arm = load_arm(
+            urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice
+        )
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None
     start, goal = (_joints(r, top[key], key, arm) for key in ("start", "goal"))
@@ -171,6 +174,12 @@ def _allowed(r: _Reader, value: Any) -> frozenset:
             r.fail(f"allowed[{k}]", "a pair of link names [LINK, LINK]", pair)
         pairs.add(frozenset(pair))
     return frozenset(pairs)
+
+
+def _fit_notice(line: str) -> None:
+    """A link cover that had to be fitted (not cached) takes seconds: say so on stderr."""
+    if "cached" not in line:
+        print(f"kcplan: covering {line}", file=sys.stderr, flush=True)
 
 
 def _is_text(value: Any) -> bool:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from kcplan.cli.common import load_input, output_file
+from kcplan.cli.common import InputError, load_input, output_file
 
 
 def run(args: argparse.Namespace) -> int:
@@ -13,6 +13,8 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.output, "-o", (".png",))
     output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
+    if getattr(scenario, "arm", None) is not None:
+        raise InputError(f"{args.scenario}: show: arms are not drawn yet")
     if args.html:
         from kcplan.html_view import write_scene_html
 

@@ -153,7 +153,7 @@ class CollisionWorld:
     def __init__(
         self, scenario: Scenario | str | os.PathLike, robot: Robot | ArrayLike | None = None
     ):
-        scenario = as_scenario(scenario)
+        scenario = as_scenario(scenario, rigid=True)
         n = scenario.dimension
         if robot is None:
             robot = scenario.robot

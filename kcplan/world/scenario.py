@@ -561,24 +561,30 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
     return parse_scenario(data, source, p.resolve().parent)
 
 
-def as_scenario(value: Scenario | str | os.PathLike) -> Scenario:
+def as_scenario(value: Scenario | str | os.PathLike, rigid: bool = False) -> Scenario:
     """The scenario a public entry point was given: ``value`` itself when it is a
-    :class:`Scenario`, the file it names when it is a path (``str`` or ``os.PathLike``,
-    read by :func:`load_scenario`).
+    :class:`Scenario` (or an arm's :class:`kcplan.arm.scenario.ArmScenario`), the file it
+    names when it is a path (``str`` or ``os.PathLike``, read by :func:`load_scenario`).
+    ``rigid``: the caller handles rigid robots only (the views: arms are not drawn yet).
 
     Raises
     ------
     TypeError
-        For anything else, saying what is expected.
+        For anything else, saying what is expected, and for an arm when ``rigid``.
     ScenarioError
         For a path whose file is not a valid scenario.
     """
     from kcplan.arm.scenario import ArmScenario
 
+    if isinstance(value, (str, os.PathLike)):
+        value = load_scenario(value)
+    if isinstance(value, ArmScenario) and rigid:
+        raise TypeError(
+            f"scenario: {value.source}: expected a rigid robot of ellipsoids, got an "
+            f"{value.arm.describe()} (arms have kcplan.arm.ArmWorld and are not drawn yet)"
+        )
     if isinstance(value, (Scenario, ArmScenario)):
         return value
-    if isinstance(value, (str, os.PathLike)):
-        return load_scenario(value)
     raise TypeError(
         "scenario: expected a kcplan Scenario or the path of a scenario file (str or "
         f"os.PathLike), got {type(value).__name__}"
