@@ -188,7 +188,8 @@ def load_arm(
         outside them).
     bodies_per_link : int
         Ellipsoids per mesh geometry (:func:`kcplan.cover.cache.cached_cover`). On MBM's
-        Panda, 4 leave 60 of 70 goals valid and 1 leaves 1 (``scripts/mbm_validity.py``);
+        Panda, 4 leave 60 of 70 goals valid, 1 leaves 1 and 8 leave 28 (the fit minimises
+        volume, not how far a body sticks out; ``scripts/mbm_validity.py``);
         fitting the Panda's ten meshes takes about 40 s once, then they are cached.
     package_dirs : sequence of path-like, optional
     progress : callable, optional
