@@ -680,3 +680,24 @@ def test_disjoint_inverted_and_badly_wound_meshes_are_covered(tmp_path, make):
     assert math.isclose(solid.volume, abs(exact.volume), rel_tol=1e-9)
     cover = fit_cover(solid, bodies=3)
     _assert_covered(solid, cover, exact, 20_000)
+
+
+def test_offsets_measure_how_far_a_cover_sticks_out(tmp_path):
+    """The smallest ellipsoid of a cube of half side h is the ball of radius h sqrt(3): it
+    sticks out of the cube by h (sqrt(3) - 1) along the face normals, which the sampled
+    estimate approaches from below; a body inside the cube sticks out by nothing."""
+    from kcplan.cover.offset import cover_offsets
+    from kcplan.geometry.robot import Body
+
+    h = 0.5
+    trimesh.creation.box(extents=[2 * h] * 3).export(tmp_path / "cube.stl")
+    solid = read_solid(tmp_path / "cube.stl")
+    ball = Body(np.full(3, h * math.sqrt(3)), np.array([0.0, 0, 0, 0, 0, 0, 1]))
+    inner = Body(np.full(3, 0.4), np.array([0.05, 0, 0, 0, 0, 0, 1]))
+    offsets = cover_offsets(solid, [ball, inner], samples=4000)
+    exact = h * (math.sqrt(3) - 1)
+    assert 0.97 * exact <= offsets[0] <= exact + 1e-9
+    assert offsets[1] == 0.0
+    (tmp_path / "square.yaml").write_text(yaml.safe_dump({"vertices": [[0, 0], [1, 0], [1, 1]]}))
+    with pytest.raises(ValueError, match="expected a 3D part"):
+        cover_offsets(read_solid(tmp_path / "square.yaml"), [ball])

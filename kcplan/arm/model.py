@@ -40,10 +40,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.cover.cache import cached_cover
+from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
 from kcplan.geometry.pose import quaternion_matrix
 
-__all__ = ["ArmBody", "ArmError", "ArmModel", "JOINT_KINDS", "load_arm"]
+__all__ = ["ArmBody", "ArmError", "ArmModel", "JOINT_KINDS", "load_arm", "mesh_cover"]
 
 JOINT_KINDS = {
     "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
@@ -311,14 +312,9 @@ def _cover(
         )
     start = time.perf_counter()
     try:
-        cover, origin = cached_cover(obj.meshPath, bodies, scale=float(scale[0]))
+        cover, origin = mesh_cover(obj.meshPath, bodies, float(scale[0]))
     except SolidError as err:
-        # a collision mesh that is not closed is a surface: its convex hull holds it
-        try:
-            cover, origin = cached_cover(obj.meshPath, bodies, scale=float(scale[0]), hull=True)
-        except SolidError:
-            raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
-        origin += " (its convex hull: the mesh is not closed)"
+        raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
     if progress is not None:
         progress(
             f"{obj.name}: {len(cover.bodies)} bod{'y' if len(cover.bodies) == 1 else 'ies'}, "
@@ -332,6 +328,26 @@ def _cover(
         frame[:3, 3] = body.pose[:3]
         out.append((frame, np.asarray(body.semi_axes, dtype=float)))
     return out
+
+
+def mesh_cover(path: str | os.PathLike, bodies: int, scale: float = 1.0) -> tuple[Cover, str]:
+    """The cover of a link's collision mesh (:func:`kcplan.cover.cache.cached_cover`), or
+    of its convex hull when the mesh is not closed (a surface: its hull holds every
+    triangle); ``origin`` says which and whether it came from the cache.
+
+    Raises
+    ------
+    SolidError
+        When neither the mesh nor its hull can be covered.
+    """
+    try:
+        return cached_cover(path, bodies, scale=scale)
+    except SolidError as err:
+        try:
+            cover, origin = cached_cover(path, bodies, scale=scale, hull=True)
+        except SolidError:
+            raise err from None
+        return cover, f"{origin} (its convex hull: the mesh is not closed)"
 
 
 def _self_pairs(geometry, bodies: list[ArmBody]) -> NDArray[np.int64]:
