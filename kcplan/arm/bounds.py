@@ -27,11 +27,13 @@ prismatic joint ``i``, its largest slide ``max(|lower_i|, |upper_i|)``; ``c_k`` 
 body's centre in its joint's frame and ``a_max,k`` its largest semi-axis.
 
 *Relative* motion of two bodies (self-collision): the joints that carry both bodies move
-them as one rigid body, which changes no distance between them, so only the joints that
-carry exactly one of the two count:
+them as one rigid body, which changes no distance between them. In the frame of the
+deepest joint that carries both (a moving frame, in which distances are the world's),
+only the joints that carry exactly one of the two move their points, each no faster than
+above (a point's distance from an axis is the same in every frame). So the distance
+between any point of body ``k`` and any point of body ``l`` changes at most at the rate
 
-    |d(x_k - x_l)/ds| <= sum_{j carries k only} |dq_j| rho[k, j]
-                         + sum_{j carries l only} |dq_j| rho[l, j].
+    sum_{j carries k only} |dq_j| rho[k, j] + sum_{j carries l only} |dq_j| rho[l, j].
 
 These are the bounds of the clearance-ball certificate for arms (a body whose clearance
 at ``q(m)`` exceeds its speed bound times ``|s - m|`` stays free on that stretch).
