@@ -113,10 +113,10 @@ def speeds(arm: ArmModel, q1: Sequence[float], q2: Sequence[float]) -> NDArray[n
 def pair_speeds(
     arm: ArmModel, q1: Sequence[float], q2: Sequence[float], pairs: NDArray[np.int64]
 ) -> NDArray[np.float64]:
-    """Bound on how fast the points of body ``k`` and body ``l`` move *relative to each
-    other* along ``q1 -> q2`` for every pair ``(k, l)`` of ``pairs`` (shape ``(m, 2)``):
-    only the joints that carry one of the two count. Shape ``(m,)``, metres per unit of
-    ``s``."""
+    """Bound on how fast the distance between a point of body ``k`` and a point of body
+    ``l`` can change along ``q1 -> q2``, for every pair ``(k, l)`` of ``pairs`` (shape
+    ``(m, 2)``): only the joints that carry one of the two count (module docstring).
+    Shape ``(m,)``, metres per unit of ``s``."""
     dq = np.abs(np.asarray(q2, dtype=float) - np.asarray(q1, dtype=float))
     rho, C = point_speeds(arm), carries(arm)
     first, second = pairs[:, 0], pairs[:, 1]
