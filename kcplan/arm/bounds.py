@@ -48,7 +48,14 @@ from numpy.typing import NDArray
 
 from kcplan.arm.model import ArmModel
 
-__all__ = ["carries", "chain_speeds", "pair_speeds", "point_speeds", "speeds"]
+__all__ = [
+    "carries",
+    "chain_speeds",
+    "pair_speeds",
+    "point_speeds",
+    "relative_speeds",
+    "speeds",
+]
 
 
 def carries(arm: ArmModel, joints: Sequence[int] | None = None) -> NDArray[np.bool_]:
@@ -110,16 +117,24 @@ def speeds(arm: ArmModel, q1: Sequence[float], q2: Sequence[float]) -> NDArray[n
     return point_speeds(arm) @ dq
 
 
+def relative_speeds(
+    rho: NDArray[np.float64], C: NDArray[np.bool_], pairs: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """``rho_pair[m, j]``: how fast the distance between a point of part ``k`` and a
+    point of part ``l``, ``(k, l) = pairs[m]``, can change per unit of joint ``j``'s
+    motion: only the joints that carry one of the two count (module docstring). From
+    ``rho`` (:func:`chain_speeds`) and ``C`` (:func:`carries`) of the same parts; shape
+    ``(len(pairs), dof)``."""
+    first, second = pairs[:, 0], pairs[:, 1]
+    return rho[first] * (C[first] & ~C[second]) + rho[second] * (C[second] & ~C[first])
+
+
 def pair_speeds(
     arm: ArmModel, q1: Sequence[float], q2: Sequence[float], pairs: NDArray[np.int64]
 ) -> NDArray[np.float64]:
     """Bound on how fast the distance between a point of body ``k`` and a point of body
     ``l`` can change along ``q1 -> q2``, for every pair ``(k, l)`` of ``pairs`` (shape
-    ``(m, 2)``): only the joints that carry one of the two count (module docstring).
-    Shape ``(m,)``, metres per unit of ``s``."""
+    ``(m, 2)``): :func:`relative_speeds` of the bodies. Shape ``(m,)``, metres per unit
+    of ``s``."""
     dq = np.abs(np.asarray(q2, dtype=float) - np.asarray(q1, dtype=float))
-    rho, C = point_speeds(arm), carries(arm)
-    first, second = pairs[:, 0], pairs[:, 1]
-    only_first = C[first] & ~C[second]
-    only_second = C[second] & ~C[first]
-    return (rho[first] * only_first) @ dq + (rho[second] * only_second) @ dq
+    return relative_speeds(point_speeds(arm), carries(arm), pairs) @ dq

@@ -21,7 +21,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike
 
-from kcplan.arm.bounds import carries, chain_speeds
+from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
 from kcplan.arm.model import ArmModel
 from kcplan.world.collision import fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
@@ -104,7 +104,7 @@ def verify_arm_path(
         dtype=int,
     ).reshape(-1, 2)
     rho = chain_speeds(arm, joints, reaches)
-    C = carries(arm, joints)
+    rho_pairs = relative_speeds(rho, carries(arm, joints), pairs)
     scene = []
     for ob in obstacles:
         for shape, tf in fcl_obstacle_parts(ob, 3):
@@ -137,9 +137,7 @@ def verify_arm_path(
     for index, (q1, q2) in enumerate(zip(states[:-1], states[1:], strict=True)):
         dq = np.abs(q2 - q1)
         v_scene = rho @ dq
-        v_pairs = (rho[pairs[:, 0]] * (C[pairs[:, 0]] & ~C[pairs[:, 1]])) @ dq + (
-            rho[pairs[:, 1]] * (C[pairs[:, 1]] & ~C[pairs[:, 0]])
-        ) @ dq
+        v_pairs = rho_pairs @ dq
         s = 0.0
         while True:
             d_scene, d_pairs = distances(q1 + s * (q2 - q1))

@@ -22,14 +22,16 @@ speeds); it imports neither OMPL nor FCL (the world does the queries).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kcplan.arm.bounds import carries, point_speeds
+from kcplan.arm.bounds import carries, point_speeds, relative_speeds
 from kcplan.planning.certifier import COUNTER_NAMES, advance
+from kcplan.planning.guard import GuardCache
 
-__all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier"]
+__all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier", "ArmGuard"]
 
 ARM_COUNTER_NAMES = tuple(
     name
@@ -40,6 +42,21 @@ ARM_COUNTER_NAMES = tuple(
 """The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
 the same meanings, less those of the steps arms do not have yet (core sweep, occupancy
 grid, probes)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ArmGuard:
+    """One guard of an arm: the certain clearance of each body to the scene
+    ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres."""
+
+    scene: np.ndarray
+    pairs: np.ndarray
+
+    @property
+    def clearance(self) -> float:
+        """The smallest of them (``inf`` with neither); > 0: the state is free. This is
+        what :class:`kcplan.planning.guard.GuardCache` reads a state's validity from."""
+        return float(min(self.scene.min(initial=math.inf), self.pairs.min(initial=math.inf)))
 
 
 class ArmEdgeCertifier:
@@ -58,7 +75,8 @@ class ArmEdgeCertifier:
     max_guards : int
         Guards per edge after the ends before "not proven".
     cache_entries : int
-        States whose validity and guard are remembered.
+        States whose validity and guard are remembered (the rigid certifier's
+        :class:`kcplan.planning.guard.GuardCache`: the oldest are dropped first).
     """
 
     backend = "python"
@@ -69,15 +87,8 @@ class ArmEdgeCertifier:
         self.n = self.arm.dof
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
-        C = carries(self.arm)
-        pairs = world.self_pairs
-        # relative speeds count only the joints that carry one body of the pair
-        first, second = pairs[:, 0], pairs[:, 1]
-        self._rho_first = self._rho[first] * (C[first] & ~C[second])
-        self._rho_second = self._rho[second] * (C[second] & ~C[first])
-        self._cache_entries = int(cache_entries)
-        self._valid: dict[bytes, bool] = {}
-        self._guards: dict[bytes, tuple] = {}
+        self._rho_pairs = relative_speeds(self._rho, carries(self.arm), world.self_pairs)
+        self.cache = GuardCache(cache_entries)
         self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
         self.covered = {"ball": 0.0}
         self.fallback = "bisection"
@@ -91,34 +102,32 @@ class ArmEdgeCertifier:
         if not self._admits(q):
             return False
         key = q.tobytes()
-        known = self._valid.get(key)
+        known = self.cache.validity(key)
         if known is None:
             self.counters["collision_queries"] += 1
             known = not self.world.in_collision(q)
-            if len(self._valid) < self._cache_entries:
-                self._valid[key] = known
+            self.cache.add_validity(key, known)
         return known
 
-    def _measure(self, q: np.ndarray) -> tuple:
+    def _measure(self, q: np.ndarray) -> ArmGuard:
         self.counters["guards"] += 1
-        return self.world.safe_clearances(q)
+        return ArmGuard(*self.world.safe_clearances(q))
 
-    def _endpoint(self, q: np.ndarray) -> tuple:
+    def _endpoint(self, q: np.ndarray) -> ArmGuard:
         key = q.tobytes()
-        guard = self._guards.get(key)
+        guard = self.cache.guard(key)
         if guard is None:
             self.counters["endpoint_guards"] += 1
             guard = self._measure(q)
-            if len(self._guards) < self._cache_entries:
-                self._guards[key] = guard
+            self.cache.add_guard(key, guard)
         else:
             self.counters["cached_guards"] += 1
         return guard
 
-    def _radius(self, guard: tuple, speed: np.ndarray, pair_speed: np.ndarray) -> float:
+    def _radius(self, guard: ArmGuard, speed: np.ndarray, pair_speed: np.ndarray) -> float:
         """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
-        scene, pairs = guard
-        if (scene <= 0.0).any() or (pairs <= 0.0).any():
+        scene, pairs = guard.scene, guard.pairs
+        if guard.clearance <= 0.0:
             return 0.0
         r = math.inf
         with np.errstate(divide="ignore"):
@@ -146,7 +155,7 @@ class ArmEdgeCertifier:
             return self._reject("rejected_end_state")
         dq = np.abs(q2 - q1)
         speed = self._rho @ dq
-        pair_speed = self._rho_first @ dq + self._rho_second @ dq
+        pair_speed = self._rho_pairs @ dq
         lo = self._radius(self._endpoint(q1), speed, pair_speed)
         if lo <= 0.0:
             return self._reject("rejected_guard")
