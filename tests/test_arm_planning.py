@@ -13,7 +13,7 @@ from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
-from kcplan.planning.states import joint_space
+from kcplan.planning.states import joint_space, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.world import parse_scenario
 
@@ -125,9 +125,8 @@ def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
     si.setup()
     start, goal = si.allocState(), si.allocState()
     target = np.array([1.64, -0.18, -2.46, -0.78, 1.21, 1.28, 1.13])
-    for state, values in ((start, READY), (goal, target)):
-        for j, v in enumerate(values):
-            state[j] = float(v)
+    set_joint_state(start, READY)
+    set_joint_state(goal, target)
     assert mv.state_valid(start) and mv.state_valid(goal)
     pdef = ob.ProblemDefinition(si)
     pdef.setStartAndGoalStates(start, goal)

@@ -26,6 +26,7 @@ from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.states import (
     joint_space,
     joint_state,
+    set_joint_state,
     set_state,
     state_pose,
     state_space,
@@ -410,8 +411,8 @@ def plan(
         scenario,
         recorder.to_json() if recorder is not None else {},
         recorder.first_solution_time if recorder is not None else None,
-        "python" if isinstance(scenario, ArmScenario) else spec.backend,
-        scenario.arm.joints if isinstance(scenario, ArmScenario) else None,
+        setup.backend,
+        setup.joints,
     )
 
 
@@ -431,6 +432,10 @@ class _Setup:
     state_valid: Callable
     read: Callable
     write: Callable
+    backend: str
+    """Who checks: ``"kernel"`` or ``"python"`` (arms: python-fcl, for now)."""
+    joints: tuple[str, ...] | None = None
+    """An arm's planning group (the states' order); None for a rigid robot."""
 
 
 def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | None) -> _Setup:
@@ -464,6 +469,7 @@ def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | 
     return _Setup(
         space, ss, si, world, validator, state_valid,
         lambda state: state_pose(state, n), lambda state, pose: set_state(state, pose, n),
+        spec.backend,
     )  # fmt: skip
 
 
@@ -489,11 +495,7 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
             q = joint_state(state, arm.dof)
             return arm.within_limits(q) and not world.in_collision(q)
 
-    def write(state, q) -> None:
-        for j, value in enumerate(q):
-            state[j] = float(value)
-
     return _Setup(
         space, ss, si, world, validator, state_valid,
-        lambda state: joint_state(state, arm.dof), write,
+        lambda state: joint_state(state, arm.dof), set_joint_state, "python", arm.joints,
     )  # fmt: skip

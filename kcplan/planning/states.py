@@ -10,7 +10,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
-__all__ = ["joint_space", "joint_state", "set_state", "state_pose", "state_space"]
+__all__ = [
+    "joint_space",
+    "joint_state",
+    "set_joint_state",
+    "set_state",
+    "state_pose",
+    "state_space",
+]
 
 
 def state_space(low: ArrayLike, high: ArrayLike) -> ob.StateSpace:
@@ -50,6 +57,12 @@ def joint_space(lower: ArrayLike, upper: ArrayLike) -> ob.RealVectorStateSpace:
 def joint_state(state, dof: int) -> np.ndarray:
     """Joint vector of a ``RealVectorStateSpace`` state, shape ``(dof,)``."""
     return np.array([state[j] for j in range(dof)])
+
+
+def set_joint_state(state, q: ArrayLike) -> None:
+    """Write a joint vector into a ``RealVectorStateSpace`` state."""
+    for j, value in enumerate(np.asarray(q, dtype=float)):
+        state[j] = float(value)
 
 
 def set_state(state, pose: ArrayLike, n: int) -> None:
