@@ -19,7 +19,7 @@ from kcplan.viz import (  # viz selects matplotlib's non-interactive backend
 )
 from kcplan.world.scenario import Scenario, as_scenario
 
-__all__ = ["animate_path"]
+__all__ = ["animate_arm", "animate_path"]
 
 
 def animate_path(
@@ -51,7 +51,9 @@ def animate_path(
     int
         The number of frames written.
     """
-    scenario = as_scenario(scenario, rigid=True)
+    scenario = as_scenario(scenario)
+    if getattr(scenario, "arm", None) is not None:
+        return animate_arm(scenario, states, path, min(frames, 40), dpi=dpi, title=title)
     n = scenario.dimension
     poses = path_poses(states, n, max(frames - 1, 1))
     fig, ax = scenario_axes(scenario)
@@ -80,3 +82,88 @@ def animate_path(
     finally:
         plt.close(fig)
     return len(poses)
+
+
+def animate_arm(
+    scenario,
+    states,
+    path: str | os.PathLike,
+    frames: int = 40,
+    fps: int = 10,
+    dpi: int = 72,
+    title: str | None = None,
+    show_cover: bool = False,
+    meshes: str = "auto",
+    max_faces: int = 400,
+) -> int:
+    """Write a GIF of an arm moving along a path through its scene.
+
+    The links' meshes (:func:`kcplan.arm_view.arm_meshes`, at most ``max_faces``
+    triangles each) are posed by Pinocchio's forward kinematics at joint vectors
+    interpolated along ``states`` (:func:`kcplan.arm_view.joint_path`); the start (green)
+    and goal (red) arms stay see-through in place, with the tip joint's path. Seen from
+    the side (:func:`kcplan.viz.arm_view_angles`).
+
+    Parameters
+    ----------
+    scenario : kcplan.arm.scenario.ArmScenario or path-like
+    states : array_like, shape (k, dof)
+        The path's joint vectors.
+    path : path-like
+        The ``.gif`` file, written atomically.
+    frames : int
+        About this many frames (every waypoint is one).
+    fps, dpi : int
+        Frame rate and resolution (at 72 dpi a frame is 576 x 504 pixels).
+    show_cover : bool
+        Draw the covering ellipsoids on the moving arm too.
+    meshes : {"auto", "visual", "collision"}
+    max_faces : int
+
+    Returns
+    -------
+    int
+        The number of frames written.
+    """
+    from kcplan.arm_view import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
+    from kcplan.viz import _arm_layer, _arm_limits, _draw_layers, _obstacle_layer, arm_view_angles
+
+    scenario = as_scenario(scenario)
+    arm = scenario.arm
+    links, _ = arm_meshes(arm, meshes, max_faces)
+    ghosts, _ = arm_meshes(arm, meshes, max(max_faces // 4, 50))
+    cover = cover_meshes(arm, 1) if show_cover else []
+    dense = joint_path(states, max(frames - 1, 1))
+    along = joint_frames_along(arm, dense)
+    ends = joint_frames_along(arm, [scenario.start, scenario.goal])
+    static = [_obstacle_layer(scenario), _arm_layer(ghosts, ends[0], (0.17, 0.63, 0.17), 0.25),
+              _arm_layer(ghosts, ends[1], (0.84, 0.15, 0.16), 0.25)]  # fmt: skip
+    moving_layers = [
+        [_arm_layer(links, F)] + ([_arm_layer(cover, F, None, 0.3)] if cover else []) for F in along
+    ]
+    points = np.concatenate(
+        [c.reshape(-1, 3) for c, _ in static] + [m[0][0].reshape(-1, 3) for m in moving_layers]
+    )
+    fig = plt.figure(figsize=(8, 7))
+    ax = fig.add_subplot(projection="3d")
+    _arm_limits(ax, points)
+    ax.view_init(*arm_view_angles(scenario))
+    ax.plot(*along[:, tip_joint(arm), :3, 3].T, color="tab:blue", lw=1.0, alpha=0.7)
+    ax.set_title(title or scenario.name, fontsize=9)
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.95)
+    moving: list = []
+
+    def show(i: int) -> list:
+        for artist in moving:
+            artist.remove()
+        moving.clear()
+        moving.append(_draw_layers(ax, static + moving_layers[i]))
+        return moving
+
+    animation = FuncAnimation(fig, show, frames=len(dense), blit=False)
+    try:
+        with atomic_output(path) as tmp:
+            animation.save(tmp, writer=PillowWriter(fps=fps), dpi=dpi)
+    finally:
+        plt.close(fig)
+    return len(dense)

@@ -46,6 +46,10 @@ def _ellipsoid(center, R, axes, n: int) -> tuple[np.ndarray, np.ndarray]:
 def _obstacle_meshes(ob: Obstacle, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
     if ob.kind in ("mesh", "convex"):
         return [(ob.vertices, ob.triangles)]
+    if ob.kind == "cylinder":
+        from kcplan.arm_view import cylinder_mesh
+
+        return [cylinder_mesh(ob)]
     if n == 2 and ob.kind in ("box", "polygon"):
         return [_flat(piece) for piece in ob.pieces]
     if ob.kind == "box":
@@ -169,12 +173,37 @@ def scene_figure(
 
 
 def write_scene_html(
-    scenario: Scenario | str | os.PathLike, path: str | os.PathLike, states=None
-) -> None:
-    """Write :func:`scene_figure` as one self-contained HTML file (plotly.js embedded;
-    works offline), atomically."""
+    scenario: Scenario | str | os.PathLike,
+    path: str | os.PathLike,
+    states=None,
+    show_cover: bool = False,
+    meshes: str = "auto",
+) -> str:
+    """Write the scene as one self-contained HTML file (plotly.js embedded; works
+    offline), atomically.
+
+    A rigid robot's page is :func:`scene_figure`. An arm's page draws its links (the
+    URDF's visual meshes when they can all be read, else its collision meshes;
+    ``meshes`` chooses) moving along ``states`` (interpolated in joint space), the start
+    (green) and goal (red) arms see-through, the tip joint's path, and a play button, a
+    frame slider and switches for the arm and its covering ellipsoids (shown at first
+    with ``show_cover``). The page poses the meshes itself from the joint frames it holds
+    (:func:`arm_view_data`, in the ``<script id="kcplan-arm-data">`` block), so each mesh
+    is stored once.
+
+    Returns
+    -------
+    str
+        What the page shows of an arm's links (e.g. ``collision meshes``), or ``""``.
+    """
+    scenario = as_scenario(scenario)
+    if getattr(scenario, "arm", None) is not None:
+        data = arm_view_data(scenario, states, meshes=meshes)
+        write_text_atomic(path, arm_html(scenario, data, show_cover))
+        return data["source"]
     html = scene_figure(scenario, states).to_html(include_plotlyjs=True, full_html=True)
     write_text_atomic(path, html)
+    return ""
 
 
 def cover_figure(cover) -> go.Figure:
@@ -205,3 +234,250 @@ def cover_figure(cover) -> go.Figure:
 def write_cover_html(cover, path: str | os.PathLike) -> None:
     """Write :func:`cover_figure` as one self-contained HTML file, atomically."""
     write_text_atomic(path, cover_figure(cover).to_html(include_plotlyjs=True, full_html=True))
+
+
+# --- arms -------------------------------------------------------------------------------
+
+_ARM_DATA_ID = "kcplan-arm-data"
+
+_ARM_CONTROLS = """<div id="kcplan-controls" style="font:13px sans-serif;padding:6px 10px">
+<button id="kc-play" type="button">play</button>
+<input id="kc-frame" type="range" min="0" max="{last}" value="0" step="1"
+ style="width:55%;vertical-align:middle">
+<span id="kc-label"></span>
+<label style="margin-left:1em"><input id="kc-arm" type="checkbox" checked> arm</label>
+<label style="margin-left:1em"><input id="kc-cover" type="checkbox"{cover}>
+ covering ellipsoids</label>
+</div>
+"""
+
+# The page poses the meshes itself: the data block holds every mesh once, in its own frame,
+# with the joint frames of every frame of the animation; a mesh's world frame is
+# joint_frames[frame][mesh.joint] @ mesh.placement (both 3 x 4, row-major).
+_ARM_SCRIPT = """
+(function () {
+  var gd = document.getElementById('{plot_id}');
+  var D = JSON.parse(document.getElementById('@DATA_ID@').textContent);
+  function compose(T, P) {
+    var M = new Array(12);
+    for (var r = 0; r < 3; r++) {
+      for (var c = 0; c < 4; c++) {
+        var v = T[4 * r] * P[c] + T[4 * r + 1] * P[4 + c] + T[4 * r + 2] * P[8 + c];
+        M[4 * r + c] = c === 3 ? v + T[4 * r + 3] : v;
+      }
+    }
+    return M;
+  }
+  function place(meshes, frames) {
+    var x = [], y = [], z = [];
+    meshes.forEach(function (m) {
+      var M = compose(frames[m.joint], m.placement), V = m.vertices;
+      for (var p = 0; p < V.length; p += 3) {
+        x.push(M[0] * V[p] + M[1] * V[p + 1] + M[2] * V[p + 2] + M[3]);
+        y.push(M[4] * V[p] + M[5] * V[p + 1] + M[6] * V[p + 2] + M[7]);
+        z.push(M[8] * V[p] + M[9] * V[p + 1] + M[10] * V[p + 2] + M[11]);
+      }
+    });
+    return [x, y, z];
+  }
+  function topology(meshes, colour) {
+    var i = [], j = [], k = [], fc = [], offset = 0;
+    meshes.forEach(function (m) {
+      var F = m.faces;
+      for (var f = 0; f < F.length; f += 3) {
+        i.push(F[f] + offset); j.push(F[f + 1] + offset); k.push(F[f + 2] + offset);
+        fc.push(colour || m.palette[m.face_palette ? m.face_palette[f / 3] : 0]);
+      }
+      offset += m.vertices.length / 3;
+    });
+    return {i: [i], j: [j], k: [k], facecolor: [fc]};
+  }
+  function restyle(index, meshes, frames, colour) {
+    var update = topology(meshes, colour), xyz = place(meshes, frames);
+    update.x = [xyz[0]]; update.y = [xyz[1]]; update.z = [xyz[2]];
+    return Plotly.restyle(gd, update, [index]);
+  }
+  var last = D.joint_frames.length - 1, current = 0, timer = null;
+  var slider = document.getElementById('kc-frame'), label = document.getElementById('kc-label');
+  var cover = document.getElementById('kc-cover'), arm = document.getElementById('kc-arm');
+  function show(k) {
+    current = k;
+    slider.value = k;
+    label.textContent = D.labels[k];
+    var frames = D.joint_frames[k], update = {x: [], y: [], z: []}, traces = [];
+    [[D.traces.arm, D.meshes, arm.checked], [D.traces.cover, D.cover, cover.checked]].forEach(
+      function (group) {
+        if (!group[2]) return;
+        var xyz = place(group[1], frames);
+        update.x.push(xyz[0]); update.y.push(xyz[1]); update.z.push(xyz[2]);
+        traces.push(group[0]);
+      });
+    if (traces.length) Plotly.restyle(gd, update, traces);
+  }
+  function visibility() {
+    Plotly.restyle(gd, {visible: [arm.checked, cover.checked]}, [D.traces.arm, D.traces.cover]);
+    show(current);
+  }
+  var start = D.start_frames, goal = D.goal_frames;
+  restyle(D.traces.start, D.meshes, start, '#2ca02c')
+    .then(function () { return restyle(D.traces.goal, D.meshes, goal, '#d62728'); })
+    .then(function () { return restyle(D.traces.arm, D.meshes, D.joint_frames[0]); })
+    .then(function () { return restyle(D.traces.cover, D.cover, D.joint_frames[0]); })
+    .then(function () {
+      var hash = /frame=(\\d+)/.exec(window.location.hash);
+      show(hash ? Math.min(parseInt(hash[1], 10), last) : 0);
+    });
+  slider.addEventListener('input', function () { show(parseInt(slider.value, 10)); });
+  cover.addEventListener('change', visibility);
+  arm.addEventListener('change', visibility);
+  document.getElementById('kc-play').addEventListener('click', function () {
+    var button = this;
+    if (timer) { clearInterval(timer); timer = null; button.textContent = 'play'; return; }
+    button.textContent = 'pause';
+    if (current >= last) show(0);
+    timer = setInterval(function () {
+      if (current < last) { show(current + 1); return; }
+      clearInterval(timer); timer = null; button.textContent = 'play';
+    }, 80);
+  });
+})();
+""".replace("@DATA_ID@", _ARM_DATA_ID)
+
+
+def _hex(rgb) -> str:
+    r, g, b = (int(round(255 * float(c))) for c in rgb)
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def _mesh_data(mesh) -> dict:
+    """One :class:`kcplan.arm_view.LinkMesh` for the page: vertices rounded to 1 µm, faces,
+    and its colours as a palette with an index per face (none when it has one colour)."""
+    palette, index = np.unique(np.round(mesh.colors, 3), axis=0, return_inverse=True)
+    out = {
+        "name": mesh.name,
+        "link": mesh.link,
+        "joint": mesh.joint,
+        "placement": mesh.placement[:3].ravel().tolist(),
+        "vertices": np.round(mesh.vertices, 6).ravel().tolist(),
+        "faces": mesh.faces.ravel().tolist(),
+        "palette": [_hex(c) for c in palette],
+    }
+    if len(palette) > 1:
+        out["face_palette"] = index.ravel().tolist()
+    return out
+
+
+def arm_view_data(
+    scenario, states=None, frames: int = 60, meshes: str = "auto", max_faces: int = 3000
+) -> dict:
+    """What the page of an arm holds (:func:`write_scene_html`): the meshes, the covering
+    ellipsoids and the joint frames of every animation frame.
+
+    Parameters
+    ----------
+    scenario : kcplan.arm.scenario.ArmScenario
+    states : array_like, shape (k, dof), optional
+        The path; interpolated in joint space into about ``frames`` frames
+        (:func:`kcplan.arm_view.joint_path`). Without it the frames are the start and the
+        goal.
+    meshes : {"auto", "visual", "collision"}
+        Which of the URDF's meshes draw the links (:func:`kcplan.arm_view.arm_meshes`).
+    max_faces : int
+        Triangles per link mesh at most.
+
+    Returns
+    -------
+    dict
+        ``states`` (the frames' joint vectors), ``joint_frames`` (per frame, per joint of
+        the reduced model: the top three rows of its world frame, row-major), ``labels``,
+        ``start_frames``, ``goal_frames``, ``meshes`` and ``cover`` (lists of
+        ``{name, link, joint, placement, vertices, faces, palette[, face_palette]}``),
+        ``source`` (which meshes) and ``path`` (the tip joint's origin per frame).
+    """
+    from kcplan.arm_view import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
+
+    arm = scenario.arm
+    if states is not None and len(states):
+        path = joint_path(states, max(frames - 1, 1))
+        last = len(path) - 1
+        labels = [f"frame {k} of {last}" + (" (start)" if k == 0 else " (goal)" if k == last
+                  else "") for k in range(len(path))]  # fmt: skip
+    else:
+        path = np.stack([scenario.start, scenario.goal])
+        labels = ["start", "goal"]
+    links, source = arm_meshes(arm, meshes, max_faces)
+    frames_ = joint_frames_along(arm, path)
+    ends = joint_frames_along(arm, [scenario.start, scenario.goal])
+    tip = tip_joint(arm)
+
+    def rows(F: np.ndarray) -> list:
+        return F[..., :3, :].reshape(len(F), 12).tolist()
+
+    return {
+        "scenario": scenario.name,
+        "source": source,
+        "joints": list(arm.joints),
+        "states": path.tolist(),
+        "labels": labels,
+        "joint_frames": [rows(F) for F in frames_],
+        "start_frames": rows(ends[0]),
+        "goal_frames": rows(ends[1]),
+        "meshes": [_mesh_data(m) for m in links],
+        "cover": [_mesh_data(m) for m in cover_meshes(arm)],
+        "path": frames_[:, tip, :3, 3].tolist() if states is not None and len(states) else [],
+    }
+
+
+def arm_figure(scenario, data: dict, show_cover: bool = False) -> go.Figure:
+    """The plotly figure of an arm's page: the obstacles, and empty traces for the start
+    and goal arms (green, red), the moving arm and its cover that the page's script fills
+    from ``data`` (:func:`arm_view_data`); ``data["traces"]`` is set to their indices."""
+    traces = []
+    for ob in scenario.obstacles:
+        for V, F in _obstacle_meshes(ob, 3):
+            trace = _mesh(V, F, "#8c8c8c", 0.45, ob.label)
+            trace.update(legendgroup="obstacles", showlegend=not traces, name="obstacles")
+            traces.append(trace)
+    if data["path"]:
+        P = np.asarray(data["path"])
+        line = {"color": "#1f77b4", "width": 3}
+        traces.append(
+            go.Scatter3d(x=P[:, 0], y=P[:, 1], z=P[:, 2], mode="lines", line=line, name="tip path")
+        )
+    roles = {}
+    for role, opacity, visible in (("start", 0.25, True), ("goal", 0.25, True), ("arm", 1.0, True),
+                                   ("cover", 0.35, show_cover)):  # fmt: skip
+        roles[role] = len(traces)
+        name = {"arm": f"arm ({data['source'].split(' (')[0]})", "cover": "covering ellipsoids"}
+        traces.append(go.Mesh3d(x=[], y=[], z=[], i=[], j=[], k=[], opacity=opacity,
+                                flatshading=True, name=name.get(role, role), hoverinfo="name",
+                                showlegend=True, visible=visible))  # fmt: skip
+    data["traces"] = roles
+    figure = go.Figure(data=traces)
+    links = data["source"].split(" (")[0]
+    figure.update_layout(
+        title=f"{scenario.name}: {scenario.arm.describe()}, links: {links}",
+        scene={"aspectmode": "data", "xaxis_title": "x", "yaxis_title": "y", "zaxis_title": "z"},
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+        legend={"x": 0.01, "y": 0.95},
+        uirevision="arm",
+    )
+    return figure
+
+
+def arm_html(scenario, data: dict, show_cover: bool = False) -> str:
+    """One self-contained HTML page (plotly.js embedded; works offline) of an arm and its
+    :func:`arm_view_data`: see :func:`write_scene_html`."""
+    import json
+
+    figure = arm_figure(scenario, data, show_cover)
+    html = figure.to_html(
+        include_plotlyjs=True, full_html=True, post_script=_ARM_SCRIPT, default_height="90vh"
+    )
+    blob = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
+    controls = _ARM_CONTROLS.format(
+        last=len(data["joint_frames"]) - 1, cover=" checked" if show_cover else ""
+    )
+    head = f'<script type="application/json" id="{_ARM_DATA_ID}">{blob}</script>\n{controls}'
+    at = html.index("<body>") + len("<body>")
+    return html[:at] + "\n" + head + html[at:]

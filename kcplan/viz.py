@@ -395,3 +395,148 @@ def plot_cover(cover, path: str | os.PathLike, tightness: str = "") -> None:
         ax.set_zlabel("z")
     fig.suptitle(title, fontsize=10)
     save_figure(fig, path)
+
+
+# --- arms -------------------------------------------------------------------------------
+
+_START_RGB, _GOAL_RGB, _PATH_RGB = (0.17, 0.63, 0.17), (0.84, 0.15, 0.16), (0.12, 0.47, 0.71)
+
+
+def arm_view_angles(scenario) -> tuple[float, float]:
+    """``(elev, azim)`` in degrees of a side view of an arm's scene: looking across the
+    line from the arm's base (the world origin) to the middle of the obstacles, so that
+    the arm reaching into them is seen from its side."""
+    centres = [np.asarray(ob.center, dtype=float)[:2] for ob in scenario.obstacles]
+    towards = np.mean(centres, axis=0) if centres else np.array([1.0, 0.0])
+    heading = float(np.degrees(np.arctan2(towards[1], towards[0])))
+    return 20.0, heading - 70.0
+
+
+def _obstacle_layer(scenario) -> tuple[np.ndarray, np.ndarray]:
+    """Every obstacle's triangles ``(m, 3, 3)`` and their RGBA, see-through grey."""
+    from kcplan.arm_view import obstacle_mesh
+
+    corners = [V[F] for V, F in (obstacle_mesh(ob) for ob in scenario.obstacles)]
+    if not corners:
+        return np.zeros((0, 3, 3)), np.zeros((0, 4))
+    corners = np.concatenate(corners)
+    return corners, np.tile([0.55, 0.55, 0.55, 0.22], (len(corners), 1))
+
+
+def _arm_layer(meshes, frames, rgb=None, alpha: float = 1.0):
+    """The arm's triangles at one state's joint frames, coloured ``rgb`` (default: each
+    mesh's own colours), with opacity ``alpha``."""
+    from kcplan.arm_view import posed_triangles
+
+    corners, colors = posed_triangles(meshes, frames)
+    if rgb is not None:
+        colors = np.tile(rgb, (len(corners), 1))
+    return corners, np.column_stack([colors, np.full(len(corners), alpha)])
+
+
+def _draw_layers(ax, layers) -> Poly3DCollection:
+    """One shaded collection of all the layers' triangles: one collection, so that
+    matplotlib orders the obstacles' and the arm's triangles by depth together."""
+    from matplotlib.colors import LightSource
+
+    corners = np.concatenate([c for c, _ in layers])
+    colors = np.concatenate([k for _, k in layers])
+    collection = Poly3DCollection(
+        corners, facecolors=colors, linewidths=0, antialiased=False, shade=True,
+        lightsource=LightSource(azdeg=225, altdeg=45),
+    )  # fmt: skip
+    ax.add_collection3d(collection)
+    return collection
+
+
+def _arm_limits(ax, points: np.ndarray) -> None:
+    """Axis limits around ``points`` ``(k, 3)`` with equal scales on the three axes."""
+    low, high = points.min(axis=0), points.max(axis=0)
+    pad = 0.03 * float((high - low).max())
+    low, high = low - pad, high + pad
+    ax.set_xlim(low[0], high[0])
+    ax.set_ylim(low[1], high[1])
+    ax.set_zlim(low[2], high[2])
+    ax.set_box_aspect(high - low)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.tick_params(labelsize=6)
+
+
+def plot_arm(
+    scenario,
+    path: str | os.PathLike,
+    states=None,
+    title: str | None = None,
+    poses: int = 3,
+    show_cover: bool = False,
+    meshes: str = "auto",
+    max_faces: int = 600,
+) -> str:
+    """Draw an arm's scene: the obstacles, the arm at its start (green) and goal (red),
+    and with a path ``states`` about ``poses`` arms along it (blue, see-through) and the
+    tip joint's path, from two viewpoints (a side view and from above).
+
+    Parameters
+    ----------
+    scenario : kcplan.arm.scenario.ArmScenario or path-like
+    path : path-like
+        The image file, written atomically.
+    states : array_like, shape (k, dof), optional
+    poses : int
+        Intermediate arms along the path (spread by joint-space length).
+    show_cover : bool
+        Also draw the covering ellipsoids at the start and the goal (wireframes).
+    meshes : {"auto", "visual", "collision"}
+        :func:`kcplan.arm_view.arm_meshes`.
+    max_faces : int
+        Triangles per link mesh at most.
+
+    Returns
+    -------
+    str
+        Which meshes draw the links.
+    """
+    from kcplan.arm_view import arm_meshes, joint_frames_along, joint_path, tip_joint
+
+    scenario = as_scenario(scenario)
+    arm = scenario.arm
+    links, source = arm_meshes(arm, meshes, max_faces)
+    ends = joint_frames_along(arm, [scenario.start, scenario.goal])
+    layers = [_obstacle_layer(scenario)]
+    layers += [
+        _arm_layer(links, ends[0], _START_RGB, 0.9),
+        _arm_layer(links, ends[1], _GOAL_RGB, 0.9),
+    ]
+    tip_path = None
+    if states is not None and len(states) > 1:
+        dense = joint_path(states, 200)
+        along = joint_frames_along(arm, dense)
+        tip_path = along[:, tip_joint(arm), :3, 3]
+        lengths = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(dense, axis=0), axis=1))]
+        for s in np.linspace(0.0, lengths[-1], poses + 2)[1:-1]:
+            k = int(np.argmin(np.abs(lengths - s)))
+            layers.append(_arm_layer(links, along[k], _PATH_RGB, 0.25))
+    points = np.concatenate([c.reshape(-1, 3) for c, _ in layers])
+    fig = plt.figure(figsize=(12, 6))
+    elev, azim = arm_view_angles(scenario)
+    for i, (e, a) in enumerate(((elev, azim), (65.0, azim + 40.0))):
+        ax = fig.add_subplot(1, 2, i + 1, projection="3d")
+        _draw_layers(ax, layers)
+        if tip_path is not None:
+            ax.plot(*tip_path.T, color="tab:blue", lw=1.0)
+        if show_cover:
+            for frames, color in ((ends[0], "tab:green"), (ends[1], "tab:red")):
+                for body in arm.bodies:
+                    T = frames[body.joint] @ body.placement
+                    surface = ellipsoid_surface(T[:3, 3], T[:3, :3], body.semi_axes, 8)
+                    ax.plot_wireframe(*surface, color=color, lw=0.25, alpha=0.5)
+        _arm_limits(ax, points)
+        ax.view_init(e, a)
+    heading = title or scenario.name
+    fig.suptitle(f"{heading}\nstart (green), goal (red); links: {source.split(' (')[0]}",
+                 fontsize=10)  # fmt: skip
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=0.9, wspace=0.0)
+    save_figure(fig, path)
+    return source

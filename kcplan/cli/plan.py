@@ -31,10 +31,16 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.animate, "--animate", (".gif",))
     output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
-    if getattr(scenario, "arm", None) is not None:
-        for option in ("plot", "animate", "html"):
-            if getattr(args, option):
-                raise InputError(f"{args.scenario}: --{option}: not available for arms yet")
+    arm = getattr(scenario, "arm", None) is not None
+    if arm and args.guards:
+        raise InputError(
+            f"{args.scenario}: --guards: not available for arms (their edges are certified "
+            "per link)"
+        )
+    for option in ("show_cover", "meshes"):
+        if not arm and getattr(args, option) not in (False, "auto"):
+            flag = "--" + option.replace("_", "-")
+            raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
     from kcplan.planning.problem import plan
 
     result = plan(scenario, args.planner, args.time, args.seed, args.simplify)
@@ -51,7 +57,14 @@ def run(args: argparse.Namespace) -> int:
 
         write_text_atomic(args.output, json.dumps(result.to_json(), indent=1) + "\n")
         print(f"path written to {args.output}")
-    if args.plot:
+    if args.plot and arm:
+        from kcplan.viz import plot_arm
+
+        source = plot_arm(scenario, args.plot, result.states if result.solved else None,
+                          title=f"{scenario.name}: {args.planner}, {status}",
+                          show_cover=args.show_cover, meshes=args.meshes)  # fmt: skip
+        print(f"plot written to {args.plot} (links: {source})")
+    elif args.plot:
         from kcplan.viz import plot_path
 
         guards = None
@@ -65,7 +78,14 @@ def run(args: argparse.Namespace) -> int:
             title=f"{scenario.name}: {args.planner}, {status}",
         )
         print(f"plot written to {args.plot}")
-    if args.animate and result.solved:
+    if args.animate and result.solved and arm:
+        from kcplan.animation import animate_arm
+
+        frames = animate_arm(scenario, result.states, args.animate,
+                             title=f"{scenario.name}: {args.planner}",
+                             show_cover=args.show_cover, meshes=args.meshes)  # fmt: skip
+        print(f"animation written to {args.animate} ({frames} frames)")
+    elif args.animate and result.solved:
         from kcplan.animation import animate_path
 
         frames = animate_path(
@@ -75,8 +95,10 @@ def run(args: argparse.Namespace) -> int:
     if args.html:
         from kcplan.html_view import write_scene_html
 
-        write_scene_html(scenario, args.html, result.states if result.solved else None)
-        print(f"interactive view written to {args.html}")
+        states = result.states if result.solved else None
+        source = write_scene_html(scenario, args.html, states, args.show_cover, args.meshes)
+        links = f" (links: {source})" if source else ""
+        print(f"interactive view written to {args.html}{links}")
     return 0 if result.solved else 1
 
 
@@ -134,4 +156,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="FILE.html",
         help="write an interactive 3D view (one self-contained HTML file, works offline)",
     )
+    add_arm_view_options(p)
     p.set_defaults(handler=run)
+
+
+def add_arm_view_options(p: argparse.ArgumentParser) -> None:
+    """``--show-cover`` and ``--meshes``, the options of an arm's pictures."""
+    p.add_argument(
+        "--show-cover",
+        action="store_true",
+        help="arms: also draw the ellipsoids covering the links (in the HTML view: shown at "
+        "first; a switch in the page shows or hides them)",
+    )
+    p.add_argument(
+        "--meshes",
+        choices=("auto", "visual", "collision"),
+        default="auto",
+        help="arms: draw the links from the URDF's visual meshes or its collision meshes "
+        "(default auto: visual when every visual mesh can be read)",
+    )

@@ -13,16 +13,26 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.output, "-o", (".png",))
     output_file(args.html, "--html", (".html",))
     scenario = load_input(args.scenario)
-    if getattr(scenario, "arm", None) is not None:
-        raise InputError(f"{args.scenario}: show: arms are not drawn yet")
+    arm = getattr(scenario, "arm", None) is not None
+    for option in ("show_cover", "meshes"):
+        if not arm and getattr(args, option) not in (False, "auto"):
+            flag = "--" + option.replace("_", "-")
+            raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
     if args.html:
         from kcplan.html_view import write_scene_html
 
-        write_scene_html(scenario, args.html)
-        print(f"interactive view written to {args.html}")
+        source = write_scene_html(scenario, args.html, None, args.show_cover, args.meshes)
+        links = f" (links: {source})" if source else ""
+        print(f"interactive view written to {args.html}{links}")
         if not args.output:
             return 0
     out = args.output or str(Path(args.scenario).with_suffix(".png"))
+    if arm:
+        from kcplan.viz import plot_arm
+
+        source = plot_arm(scenario, out, show_cover=args.show_cover, meshes=args.meshes)
+        print(f"picture written to {out} (links: {source})")
+        return 0
     from kcplan.viz import plot_scenario
 
     plot_scenario(scenario, out, guards=scenario.inflation)
@@ -36,7 +46,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "show",
         help="draw a scenario",
         description="Draw a scenario: obstacles, bounds, start (green) and goal (red) robots "
-        "with their guards (dotted). 2D top view, 3D perspective.",
+        "with their guards (dotted). 2D top view, 3D perspective; an arm at its start and goal "
+        "from two viewpoints.",
     )
     p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
     p.add_argument(
@@ -47,4 +58,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "when given)",
     )
     p.add_argument("--html", metavar="FILE.html", help="write an interactive 3D view")
+    from kcplan.cli.plan import add_arm_view_options
+
+    add_arm_view_options(p)
     p.set_defaults(handler=run)
