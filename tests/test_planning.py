@@ -17,7 +17,7 @@ from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.rotations import log_rotation
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.ladder import GuardLadder
-from kcplan.planning.names import CERTIFIABLE
+from kcplan.planning.names import ARM_ONLY, CERTIFIABLE
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
@@ -209,7 +209,9 @@ def test_kc_planners_never_return_colliding_paths(path, planner, tmp_path):
     assert np.allclose(states[0], scenario.start) and np.allclose(states[-1], scenario.goal)
 
 
-@pytest.mark.parametrize("planner", [p for p in PLANNERS if not PLANNERS[p].kc])
+@pytest.mark.parametrize(
+    "planner", [p for p in PLANNERS if not PLANNERS[p].kc and p not in ARM_ONLY]
+)
 def test_stock_planners_run_through_the_same_setup(planner):
     scenario = load_scenario(ROOT / "scenarios" / "2d" / "open_field.yaml")
     result = plan(scenario, planner, time_limit=1.0, seed=1)

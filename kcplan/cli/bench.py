@@ -41,6 +41,12 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as err:
             raise InputError(f"kcplan bench: --planners: {err}") from None
     scenarios = [load_input(path) for path in args.scenarios]
+    for scenario in scenarios:  # arm-only planners refuse a rigid robot up front
+        for name in planners:
+            try:
+                check_planner_name(name, arm=getattr(scenario, "arm", None) is not None)
+            except ValueError as err:
+                raise InputError(f"{scenario.source}: --planners: {err}") from None
     names = [s.name for s in scenarios]
     if len(set(names)) != len(names):
         twice = sorted({n for n in names if names.count(n) > 1})

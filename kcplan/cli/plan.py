@@ -41,8 +41,13 @@ def run(args: argparse.Namespace) -> int:
         if not arm and getattr(args, option) not in (False, "auto"):
             flag = "--" + option.replace("_", "-")
             raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
+    from kcplan.planning.names import check_planner_name
     from kcplan.planning.problem import plan
 
+    try:  # an arm-only planner on a rigid robot: one line, exit 2
+        check_planner_name(args.planner, arm=arm)
+    except ValueError as err:
+        raise InputError(f"{args.scenario}: --planner: {err}") from None
     result = plan(scenario, args.planner, args.time, args.seed, args.simplify)
     status = "solved" if result.solved else "NOT solved"
     print(

@@ -23,6 +23,21 @@ STOCK = ("rrtconnect", "prm", "rrtconnect-fine", "prm-fine", *CERTIFIABLE, *LAST
 query; each also as ``<name>-fcl``, the same on python-fcl (what a Python user writes by
 hand)."""
 
+JOINT_STEP = 1.0 / 32.0
+"""The largest step between the states that ``rrtconnect-32`` and ``prm-32`` check on an
+edge, radians of joint-space distance (OMPL's: the L2 norm of the joint difference), as
+VAMP's 1/32 rad resolution."""
+
+ARM_ONLY = {
+    "rrtconnect-32": "stock RRT-Connect checking an edge every 1/32 rad of joint-space "
+    "distance, which only an arm's joint space has",
+    "prm-32": "stock PRM checking an edge every 1/32 rad of joint-space distance, which "
+    "only an arm's joint space has",
+    "rrtconnect-pin": "stock RRT-Connect checking states with Pinocchio's computeCollisions "
+    "on the link covers of a URDF robot",
+}
+"""Planners for arms only, with what they are (the reason a rigid robot is refused)."""
+
 PLANNER_NAMES = (
     "kc-rrtconnect",
     "kc-prm",
@@ -36,6 +51,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-py",
     "kc-prm-py",
     *STOCK,
+    *ARM_ONLY,
     *(f"{name}-fcl" for name in STOCK),
     *(f"kc-{name}" for name in CERTIFIABLE),
     *(f"ca-{name}" for name in CERTIFIABLE),
@@ -54,10 +70,15 @@ REFUSED_PLANNERS = {
 """Certified variants refused on purpose, with the reason given to the user."""
 
 
-def check_planner_name(name: str) -> str:
-    """``name`` if it is a planner; otherwise ``ValueError`` with one line saying why."""
+def check_planner_name(name: str, arm: bool | None = None) -> str:
+    """``name`` if it is a planner; otherwise ``ValueError`` with one line saying why.
+
+    ``arm=False`` (a rigid robot's scenario) also refuses the planners of
+    :data:`ARM_ONLY`; None checks the name alone."""
     if name in REFUSED_PLANNERS:
         raise ValueError(f"{name}: refused: {REFUSED_PLANNERS[name]}")
     if name not in PLANNER_NAMES:
         raise ValueError(f"expected a planner name ({', '.join(PLANNER_NAMES)}), got {name!r}")
+    if arm is False and name in ARM_ONLY:
+        raise ValueError(f"{name}: for arms only: {ARM_ONLY[name]}; this robot is rigid")
     return name

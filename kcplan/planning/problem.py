@@ -21,7 +21,13 @@ from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.arm.world import ArmWorld
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
-from kcplan.planning.names import CERTIFIABLE, PLANNER_NAMES, STOCK, check_planner_name
+from kcplan.planning.names import (
+    CERTIFIABLE,
+    JOINT_STEP,
+    PLANNER_NAMES,
+    STOCK,
+    check_planner_name,
+)
 from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.states import (
     joint_space,
@@ -48,7 +54,11 @@ class PlannerSpec:
     :class:`KCMotionValidator` uses (:data:`CERTIFICATE_SETS`). ``backend`` says who
     checks: ``"kernel"`` (the compiled kernel on coal: the certifier of a kc planner, the
     collision query of a stock one) or ``"python"`` (the Python certifier on python-fcl;
-    for a stock planner the python-fcl state checker).
+    for a stock planner the python-fcl state checker; ``"pin"``: an arm's Python
+    ``isValid`` on Pinocchio, :mod:`kcplan.planning.pin_checker`). ``joint_step`` (arms,
+    stock): the largest step between the states the discrete validator checks on an
+    edge, radians of OMPL's joint-space distance (the L2 norm of the joint difference);
+    the resolution is set to ``joint_step / space.getMaximumExtent()`` at setup.
     """
 
     make: type
@@ -60,6 +70,7 @@ class PlannerSpec:
     neighbors: int | None = None  # PRM's maximum nearest neighbours (OMPL default 10)
     backend: str = "kernel"
     probes: int = DEFAULT_PROBES  # collision probes per edge before its guards (kc)
+    joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
 
     @property
     def kc(self) -> bool:
@@ -170,6 +181,19 @@ for _name in STOCK:
         description=f"{_spec.description}, states checked by python-fcl (by hand in Python)",
         backend="python",
     )
+for _name, _make, _what in (("rrtconnect", og.RRTConnect, "RRT-Connect"), ("prm", og.PRM, "PRM")):
+    PLANNERS[f"{_name}-32"] = PlannerSpec(
+        _make,
+        description=f"stock {_what}, arms only: discrete validator stepping at most 1/32 rad "
+        "of joint-space distance (the L2 norm of the joint difference), like VAMP's",
+        joint_step=JOINT_STEP,
+    )
+PLANNERS["rrtconnect-pin"] = PlannerSpec(
+    og.RRTConnect,
+    description="stock RRT-Connect, arms only: a Python isValid calling Pinocchio's "
+    "computeCollisions on the same ellipsoid cover (kcplan.planning.pin_checker)",
+    backend="pin",
+)
 PLANNERS = {name: PLANNERS[name] for name in PLANNER_NAMES}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
 default discrete motion validator at the default resolution (1 % of the space extent),
@@ -324,6 +348,10 @@ def plan(
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     scenario = as_scenario(scenario)
+    try:  # the arm-only planners refuse a rigid robot
+        check_planner_name(planner, arm=isinstance(scenario, ArmScenario))
+    except ValueError as err:
+        raise ValueError(f"planner: {err}") from None
     spec = PLANNERS[planner]
     if seed is not None:
         seed_ompl(seed)
@@ -489,11 +517,18 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
         validator = KCMotionValidator(si, arm, world)
         si.setMotionValidator(validator)
         state_valid = validator.state_valid
+    elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand
+        from kcplan.planning.pin_checker import PinChecker
+
+        state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
     else:
 
         def state_valid(state) -> bool:
             q = joint_state(state, arm.dof)
             return arm.within_limits(q) and not world.in_collision(q)
+
+    if spec.joint_step is not None:  # at most joint_step between checked states (L2, rad)
+        si.setStateValidityCheckingResolution(spec.joint_step / space.getMaximumExtent())
 
     return _Setup(
         space, ss, si, world, validator, state_valid,
