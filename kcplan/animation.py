@@ -136,6 +136,7 @@ def animate_arm(
     dense = joint_path(states, max(frames - 1, 1))
     along = joint_frames_along(arm, dense)
     ends = joint_frames_along(arm, [scenario.start, scenario.goal])
+    ghosts = [m for m in ghosts if m.joint != 0]  # the fixed links are drawn moving
     static = [_obstacle_layer(scenario), _arm_layer(ghosts, ends[0], (0.17, 0.63, 0.17), 0.25),
               _arm_layer(ghosts, ends[1], (0.84, 0.15, 0.16), 0.25)]  # fmt: skip
     moving_layers = [

@@ -368,7 +368,7 @@ def _mesh_data(mesh) -> dict:
 
 
 def arm_view_data(
-    scenario, states=None, frames: int = 60, meshes: str = "auto", max_faces: int = 3000
+    scenario, states=None, frames: int = 60, meshes: str = "auto", max_faces: int = 2000
 ) -> dict:
     """What the page of an arm holds (:func:`write_scene_html`): the meshes, the covering
     ellipsoids and the joint frames of every animation frame.

@@ -473,6 +473,7 @@ def plot_arm(
     show_cover: bool = False,
     meshes: str = "auto",
     max_faces: int = 600,
+    dpi: int = 90,
 ) -> str:
     """Draw an arm's scene: the obstacles, the arm at its start (green) and goal (red),
     and with a path ``states`` about ``poses`` arms along it (blue, see-through) and the
@@ -492,6 +493,8 @@ def plot_arm(
         :func:`kcplan.arm_view.arm_meshes`.
     max_faces : int
         Triangles per link mesh at most.
+    dpi : int
+        Resolution (90: about 1080 x 540 pixels).
 
     Returns
     -------
@@ -504,7 +507,9 @@ def plot_arm(
     arm = scenario.arm
     links, source = arm_meshes(arm, meshes, max_faces)
     ends = joint_frames_along(arm, [scenario.start, scenario.goal])
-    layers = [_obstacle_layer(scenario)]
+    fixed = [m for m in links if m.joint == 0]  # drawn once: they never move
+    links = [m for m in links if m.joint != 0] or links
+    layers = [_obstacle_layer(scenario)] + ([_arm_layer(fixed, ends[0])] if fixed else [])
     layers += [
         _arm_layer(links, ends[0], _START_RGB, 0.9),
         _arm_layer(links, ends[1], _GOAL_RGB, 0.9),
@@ -538,5 +543,5 @@ def plot_arm(
     fig.suptitle(f"{heading}\nstart (green), goal (red); links: {source.split(' (')[0]}",
                  fontsize=10)  # fmt: skip
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=0.9, wspace=0.0)
-    save_figure(fig, path)
+    save_figure(fig, path, dpi=dpi)
     return source
