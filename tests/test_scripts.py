@@ -8,6 +8,7 @@ without a case here fails :func:`test_every_script_has_a_case`.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import re
@@ -24,6 +25,7 @@ SCRIPTS = ROOT / "scripts"
 HRM = ROOT.parent / "shared" / "data" / "external" / "hrm" / "resources"
 CORRIDOR = "scenarios/2d/narrow_corridor.yaml"
 NUMBER = r"-?\d+(?:\.\d+)?"
+HAVE_VAMP = importlib.util.find_spec("vamp") is not None  # an optional peer (issue 25)
 
 
 @dataclass(frozen=True)
@@ -247,6 +249,68 @@ CASES = [
         )
     ),
 ]
+
+
+def _vamp_problems(out: str, _tmp: Path) -> None:
+    """vamp_mbm.py --step read: the first problem of each MBM class, as plain data."""
+    problems = json.loads(out)
+    assert [(p["class"], p["index"]) for p in problems] == [
+        (c, 1) for c in ("table_pick", "table_under_pick", "box", "bookshelf_small",
+                         "bookshelf_tall", "bookshelf_thin", "cage")
+    ]  # fmt: skip
+    assert all(len(p["start"]) == len(p["goal"]) == 7 and p["obstacles"] for p in problems)
+    assert {o["kind"] for p in problems for o in p["obstacles"]} == {"box", "cylinder"}
+
+
+CASES.append(
+    Case(
+        "vamp_mbm.py",
+        ("--per-class", "1", "--calls", "1"),
+        (r"^\| all \| 7 \| \d \| \d \| [\d.]+ \| [\d.]+ \| \d of \d \|$",),
+    )
+    if HAVE_VAMP  # VAMP built into this environment: the whole run
+    else Case("vamp_mbm.py", ("--step", "read", "--per-class", "1"), check=_vamp_problems)
+)
+
+
+@pytest.mark.skipif(HAVE_VAMP, reason="VAMP is installed here")
+def test_vamp_mbm_without_vamp_says_how_to_build_it():
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPTS / "vamp_mbm.py"), "--per-class", "1"],
+        cwd=ROOT, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 2 and proc.stdout == ""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("vamp_mbm.py: VAMP is not installed in ")
+    assert "bash ../shared/tools/vamp/build-vamp.sh PYTHON" in lines[0]
+
+
+def test_vamp_mbm_verifies_paths_on_the_meshes():
+    """kcplan's half of vamp_mbm.py: a path that stays at the start is clean on the meshes,
+    one reaching into the objects collides, an unsolved problem has no verdict."""
+    import numpy as np
+
+    from kcplan.arm.mbm import read_mbm_archive
+
+    archive = ROOT.parent / "shared" / "data" / "external" / "mbm" / "panda" / "problems.tar.bz2"
+    start = read_mbm_archive(archive, "table_pick", 1).start
+    down = start.copy()
+    down[0], down[1], down[3] = 1.17, 1.3, -1.0  # reaching into the objects at y ~ 1 m
+    results = [
+        {"class": "table_pick", "index": 1, "solved": True, "path": [start.tolist()] * 2},
+        {"class": "table_pick", "index": 1, "solved": True,
+         "path": [start.tolist(), np.asarray(down).tolist()]},
+        {"class": "box", "index": 1, "solved": False, "path": []},
+    ]  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPTS / "vamp_mbm.py"), "--step", "verify"],
+        input=json.dumps({"results": results}), cwd=ROOT, capture_output=True, text=True,
+        timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    verdicts = json.loads(proc.stdout)
+    assert [v["collides"] for v in verdicts] == [False, True, None]
+    assert verdicts[0]["min_clearance"] > 0.0 and verdicts[1]["where"][0] == 0
 
 
 def test_every_script_has_a_case():
