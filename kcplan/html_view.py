@@ -102,7 +102,12 @@ def scene_figure(
     """The scene (a scenario, or the path of its file; and the path ``states``, shape
     ``(k, 3 or 7)``, with the robot moving along it in about ``frames`` steps) as a
     plotly figure."""
-    scenario = as_scenario(scenario, rigid=True)
+    scenario = as_scenario(scenario)
+    if getattr(scenario, "arm", None) is not None:
+        raise TypeError(
+            f"scenario: {scenario.source}: an arm's page is made by write_scene_html or "
+            "arm_html (its script poses the meshes), not by scene_figure"
+        )
     n = scenario.dimension
     traces = []
     for ob in scenario.obstacles:

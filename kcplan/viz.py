@@ -287,8 +287,11 @@ def plot_scenario(
     guards: float | None = None,
 ) -> None:
     """Draw a scenario (or the scenario file at a path; 2D top view or 3D perspective)
-    into an image file."""
-    scenario = as_scenario(scenario, rigid=True)
+    into an image file; an arm at its start and goal (:func:`plot_arm`)."""
+    scenario = as_scenario(scenario)
+    if getattr(scenario, "arm", None) is not None:
+        plot_arm(scenario, path, title=title)
+        return
     fig, ax = scenario_axes(scenario)
     draw_scenario(ax, scenario, poses, guards)
     heading = f"{scenario.name}: {scenario.description}" if scenario.description else scenario.name
@@ -321,8 +324,13 @@ def plot_path(
 ) -> None:
     """Draw a scenario with a path: its centre line, the robot at intervals along it and,
     if given, guards as ``(pose, inflation)`` pairs (dashed); ``scenario`` may be the
-    path of a scenario file."""
-    scenario = as_scenario(scenario, rigid=True)
+    path of a scenario file. An arm is drawn by :func:`plot_arm` (no guards)."""
+    scenario = as_scenario(scenario)
+    if getattr(scenario, "arm", None) is not None:
+        if guards:
+            raise ValueError("guards: expected none for an arm (its edges are certified per link)")
+        plot_arm(scenario, path, states if len(states) else None, title=title)
+        return
     n = scenario.dimension
     poses = path_poses(states, n) if len(states) else []
     fig, ax = scenario_axes(scenario)

@@ -178,6 +178,19 @@ def test_the_gif_has_the_expected_frames_and_size(scenario, tmp_path):
         assert gif.n_frames == count and gif.size == (240, 210)
 
 
+def test_the_public_views_take_arms(scenario, reach, tmp_path):
+    from kcplan.html_view import scene_figure
+    from kcplan.viz import plot_path, plot_scenario
+
+    plot_path(scenario, PATH, tmp_path / "path.png")
+    plot_scenario(reach, tmp_path / "scene.png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["path.png", "scene.png"]
+    with pytest.raises(ValueError, match="guards: expected none for an arm"):
+        plot_path(scenario, PATH, tmp_path / "g.png", guards=[(None, 0.1)])
+    with pytest.raises(TypeError, match="an arm's page is made by write_scene_html"):
+        scene_figure(scenario)
+
+
 def test_a_failed_gif_leaves_no_file(scenario, tmp_path, monkeypatch):
     from matplotlib.animation import FuncAnimation
 
