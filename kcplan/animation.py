@@ -31,7 +31,8 @@ def animate_path(
     dpi: int = 72,
     title: str | None = None,
 ) -> int:
-    """Write a GIF of every body of the robot moving along ``states``.
+    """Write a GIF of every body of the robot moving along ``states`` (an arm: its links,
+by :func:`animate_arm`, at most 40 frames).
 
     Parameters
     ----------

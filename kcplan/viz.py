@@ -496,7 +496,7 @@ def plot_arm(
     poses : int
         Intermediate arms along the path (spread by joint-space length).
     show_cover : bool
-        Also draw the covering ellipsoids at the start and the goal (wireframes).
+        Also draw the covering ellipsoids at the start and the goal (see-through).
     meshes : {"auto", "visual", "collision"}
         :func:`kcplan.arm_view.arm_meshes`.
     max_faces : int
@@ -531,6 +531,12 @@ def plot_arm(
         for s in np.linspace(0.0, lengths[-1], poses + 2)[1:-1]:
             k = int(np.argmin(np.abs(lengths - s)))
             layers.append(_arm_layer(links, along[k], _PATH_RGB, 0.25))
+    if show_cover:  # see-through, in the same collection: ordered by depth with the links
+        from kcplan.arm_view import cover_meshes
+
+        cover = cover_meshes(arm, 1)
+        layers += [_arm_layer(cover, ends[0], _START_RGB, 0.2),
+                   _arm_layer(cover, ends[1], _GOAL_RGB, 0.2)]  # fmt: skip
     points = np.concatenate([c.reshape(-1, 3) for c, _ in layers])
     fig = plt.figure(figsize=(12, 6))
     elev, azim = arm_view_angles(scenario)
@@ -539,12 +545,6 @@ def plot_arm(
         _draw_layers(ax, layers)
         if tip_path is not None:
             ax.plot(*tip_path.T, color="tab:blue", lw=1.0)
-        if show_cover:
-            for frames, color in ((ends[0], "tab:green"), (ends[1], "tab:red")):
-                for body in arm.bodies:
-                    T = frames[body.joint] @ body.placement
-                    surface = ellipsoid_surface(T[:3, 3], T[:3, :3], body.semi_axes, 8)
-                    ax.plot_wireframe(*surface, color=color, lw=0.25, alpha=0.5)
         _arm_limits(ax, points)
         ax.view_init(e, a)
     heading = title or scenario.name
