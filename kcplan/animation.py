@@ -32,7 +32,7 @@ def animate_path(
     title: str | None = None,
 ) -> int:
     """Write a GIF of every body of the robot moving along ``states`` (an arm: its links,
-by :func:`animate_arm`, at most 40 frames).
+    by :func:`animate_arm`, at most 40 frames).
 
     Parameters
     ----------
@@ -102,7 +102,8 @@ def animate_arm(
     The links' meshes (:func:`kcplan.arm_view.arm_meshes`, at most ``max_faces``
     triangles each) are posed by Pinocchio's forward kinematics at joint vectors
     interpolated along ``states`` (:func:`kcplan.arm_view.joint_path`); the start (green)
-    and goal (red) arms stay see-through in place, with the tip joint's path. Seen from
+    and goal (red) arms stay see-through in place (their collision meshes, coarser), with
+    the tip joint's path. Seen from
     the side (:func:`kcplan.viz.arm_view_angles`).
 
     Parameters
@@ -132,7 +133,7 @@ def animate_arm(
     scenario = as_scenario(scenario)
     arm = scenario.arm
     links, _ = arm_meshes(arm, meshes, max_faces)
-    ghosts, _ = arm_meshes(arm, meshes, max(max_faces // 4, 50))
+    ghosts, _ = arm_meshes(arm, "collision", max(max_faces // 4, 50))  # closed, coarse
     cover = cover_meshes(arm, 1) if show_cover else []
     dense = joint_path(states, max(frames - 1, 1))
     along = joint_frames_along(arm, dense)
