@@ -166,6 +166,44 @@ var Plotly = {restyle: function (gd, update, traces) {
     assert set(goal["update"]["facecolor"][0]) == {"#d62728"}
 
 
+def test_the_page_renders_the_arm_moving_in_a_headless_browser(scenario, tmp_path):
+    """Chromium (headless, offline) renders the page at its first and last frame (the
+    ``#frame=N`` address): the see-through goal arm (red) shows at the first, the start arm
+    (green) once the arm has left it, and the picture changes (without the page's script
+    neither arm is drawn: under 1e-5 of the pixels)."""
+    import os
+
+    from PIL import Image
+
+    from kcplan.html_view import write_scene_html
+
+    browser = shutil.which("chromium")
+    if browser is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI installs Debian's chromium for this test (.ci/run)")
+        pytest.skip("no chromium (apt-get install chromium)")
+    page = tmp_path / "arm.html"
+    write_scene_html(scenario, page, PATH)
+    shots = []
+    for frame in (0, 10_000):  # the page clamps the frame to its last one
+        shot = tmp_path / f"shot{frame}.png"
+        subprocess.run(
+            [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+             "--window-size=900,700", "--virtual-time-budget=10000", f"--screenshot={shot}",
+             f"{page.as_uri()}#frame={frame}"],
+            capture_output=True, timeout=120, check=True,
+        )  # fmt: skip
+        shots.append(np.asarray(Image.open(shot).convert("RGB")).astype(int))
+    red, green = [], []
+    for image in shots:
+        r, g, b = image[..., 0], image[..., 1], image[..., 2]
+        red.append(((r - g > 30) & (r - b > 30)).mean())
+        green.append(((g - r > 25) & (g - b > 15)).mean())
+    assert red[0] > 0.002 and green[1] > 0.002 and green[1] > 5 * green[0], (red, green)
+    moved = np.abs(shots[0] - shots[1]).sum(axis=2) > 60
+    assert moved.mean() > 0.01, moved.mean()
+
+
 def test_the_gif_has_the_expected_frames_and_size(scenario, tmp_path):
     from PIL import Image
 
