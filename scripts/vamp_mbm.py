@@ -21,8 +21,10 @@ class of VAMP's ``problems.tar.bz2`` (read by :mod:`kcplan.arm.mbm`):
    fixed at its start value.
 
 It prints one Markdown table: per class, problems, solved, median planning and
-simplification time, and how many simplified paths collide on the meshes. Times are
-from the machine it runs on (indicative on a shared, loaded one).
+simplification time, and how many simplified paths collide on the meshes (then where
+each colliding path first touches: segment and fraction ``s`` along it); ``--json``
+also writes every path, time and verdict. Times are from the machine it runs on
+(indicative on a shared, loaded one).
 
 Two halves, each in a Python that has what it needs. kcplan's half (reading the problems,
 verifying the paths) imports kcplan, whose collision world needs kcplan's compiled kernel
@@ -297,6 +299,7 @@ def main(argv: list[str] | None = None) -> int:
         default=os.fspath(ROOT / ".venv" / "bin" / "python"),
         help="a Python with kcplan, when this one has none (default: the repository's .venv)",
     )
+    parser.add_argument("--json", help="also write every result and verdict to this file")
     parser.add_argument("--step", choices=sorted(STEPS), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.per_class < 1 or args.calls < 1:
@@ -318,6 +321,8 @@ def main(argv: list[str] | None = None) -> int:
     verdicts = _run_step("verify", {"results": results}, args)
     for line in table(results, verdicts):
         print(line)
+    if args.json:
+        Path(args.json).write_text(json.dumps({"results": results, "verdicts": verdicts}) + "\n")
     for r, v in zip(results, verdicts, strict=True):
         if v["collides"]:
             segment, s = v["where"]
