@@ -47,6 +47,7 @@ __all__ = [
     "mesh_frames",
     "posed_triangles",
     "tip_joint",
+    "visual_meshes_missing",
 ]
 
 COLLISION_RGB = (0.62, 0.66, 0.74)
@@ -241,6 +242,12 @@ def _visual_geometry(arm):
         placements.append(np.asarray((reduced.placement * in_link).homogeneous, dtype=float))
         joints.append(int(reduced.parentJoint))
     return (objects, links, placements, joints), ""
+
+
+def visual_meshes_missing(arm) -> str:
+    """Why the arm's visual meshes cannot be drawn (``""`` when they can): reads the
+    URDF's visual geometry with Pinocchio, as :func:`arm_meshes` does."""
+    return _visual_geometry(arm)[1]
 
 
 def arm_meshes(arm, source: str = "auto", max_faces: int = 3000) -> tuple[list[LinkMesh], str]:

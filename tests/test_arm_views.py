@@ -267,6 +267,8 @@ def test_plan_and_show_draw_arms_and_refuse_bad_outputs(reach, tmp_path, capsys)
          "--guards: not available for arms"),
         (["show", str(ROOT / "scenarios" / "2d" / "l_turn.yaml"), "--show-cover"],
          "--show-cover: only for arms"),
+        (["show", str(reach), "--meshes", "visual", "-o", str(out / "v.png")],
+         "--meshes visual: Mesh package://meshes/visual/link1.obj"),  # none bundled
     ]  # fmt: skip
     for argv, message in bad:
         assert main(argv) == 2, argv

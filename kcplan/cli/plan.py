@@ -41,6 +41,12 @@ def run(args: argparse.Namespace) -> int:
         if not arm and getattr(args, option) not in (False, "auto"):
             flag = "--" + option.replace("_", "-")
             raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
+    if arm and args.meshes == "visual" and (args.plot or args.animate or args.html):
+        from kcplan.arm_view import visual_meshes_missing
+
+        reason = visual_meshes_missing(scenario.arm)
+        if reason:
+            raise InputError(f"{args.scenario}: --meshes visual: {reason}")
     from kcplan.planning.names import check_planner_name
     from kcplan.planning.problem import plan
 

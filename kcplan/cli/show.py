@@ -18,6 +18,12 @@ def run(args: argparse.Namespace) -> int:
         if not arm and getattr(args, option) not in (False, "auto"):
             flag = "--" + option.replace("_", "-")
             raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
+    if arm and args.meshes == "visual":
+        from kcplan.arm_view import visual_meshes_missing
+
+        reason = visual_meshes_missing(scenario.arm)
+        if reason:
+            raise InputError(f"{args.scenario}: --meshes visual: {reason}")
     if args.html:
         from kcplan.html_view import write_scene_html
 
