@@ -27,7 +27,6 @@ GIF stays small and fast.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -420,8 +419,3 @@ def tip_joint(arm) -> int:
 
     ids = [model.getJointId(name) for name in arm.joints]
     return max(ids, key=depth)
-
-
-def describe_size(path: str | os.PathLike) -> str:
-    """``1.2 MB`` for a file's size."""
-    return f"{os.path.getsize(path) / 1e6:.1f} MB"
