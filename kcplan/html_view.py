@@ -263,6 +263,10 @@ _ARM_SCRIPT = """
 (function () {
   var gd = document.getElementById('{plot_id}');
   var D = JSON.parse(document.getElementById('@DATA_ID@').textContent);
+  D.cover.forEach(function (c) {  // each body: the unit sphere scaled by its semi-axes
+    c.vertices = D.sphere.vertices.map(function (v, i) { return v * c.semi_axes[i % 3]; });
+    c.faces = D.sphere.faces;
+  });
   function compose(T, P) {
     var M = new Array(12);
     for (var r = 0; r < 3; r++) {
@@ -395,9 +399,11 @@ def arm_view_data(
     dict
         ``states`` (the frames' joint vectors), ``joint_frames`` (per frame, per joint of
         the reduced model: the top three rows of its world frame, row-major), ``labels``,
-        ``start_frames``, ``goal_frames``, ``meshes`` and ``cover`` (lists of
-        ``{name, link, joint, placement, vertices, faces, palette[, face_palette]}``),
-        ``source`` (which meshes) and ``path`` (the tip joint's origin per frame).
+        ``start_frames``, ``goal_frames``, ``meshes`` (a list of ``{name, link, joint,
+        placement, vertices, faces, palette[, face_palette]}``), ``cover`` (the same with
+        ``semi_axes`` that scale the unit ``sphere``'s vertices instead of vertices and
+        faces), ``source`` (which meshes) and ``path`` (the tip joint's origin per
+        frame). Frames are rounded to 12 decimals, vertices to 1 µm.
     """
     from kcplan.arm_view import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
 
@@ -415,8 +421,19 @@ def arm_view_data(
     ends = joint_frames_along(arm, [scenario.start, scenario.goal])
     tip = tip_joint(arm)
 
-    def rows(F: np.ndarray) -> list:
-        return F[..., :3, :].reshape(len(F), 12).tolist()
+    def rows(F: np.ndarray) -> list:  # 12 decimals: within 1e-12 of Pinocchio's frames
+        return np.round(F[..., :3, :].reshape(len(F), 12), 12).tolist()
+
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(2)  # cover_meshes' unit sphere, stored once
+    palette = [_mesh_data(m)["palette"] for m in cover_meshes(arm, 0)]
+    cover = [
+        {"name": f"cover {k}", "link": b.link, "joint": int(b.joint),
+         "placement": np.asarray(b.placement)[:3].ravel().tolist(),
+         "semi_axes": np.asarray(b.semi_axes).tolist(), "palette": palette[k]}
+        for k, b in enumerate(arm.bodies)
+    ]  # fmt: skip
 
     return {
         "scenario": scenario.name,
@@ -428,7 +445,11 @@ def arm_view_data(
         "start_frames": rows(ends[0]),
         "goal_frames": rows(ends[1]),
         "meshes": [_mesh_data(m) for m in links],
-        "cover": [_mesh_data(m) for m in cover_meshes(arm)],
+        "sphere": {
+            "vertices": np.round(sphere.vertices, 6).ravel().tolist(),
+            "faces": np.asarray(sphere.faces).ravel().tolist(),
+        },
+        "cover": cover,
         "path": frames_[:, tip, :3, 3].tolist() if states is not None and len(states) else [],
     }
 

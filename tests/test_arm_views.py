@@ -14,7 +14,8 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from kcplan.arm_view import arm_meshes, decimate, joint_path, mesh_frames
+from kcplan.arm.kinematics import body_frames
+from kcplan.arm_view import arm_meshes, cover_meshes, decimate, joint_path, mesh_frames
 from kcplan.cli import main
 from kcplan.world import load_scenario
 
@@ -116,6 +117,10 @@ def test_the_page_holds_every_frame_and_mesh_posed_as_pinocchio_poses_them(scena
         for mesh, oMg in zip(data["meshes"], expected, strict=True):
             world = _frame(data["joint_frames"][k][mesh["joint"]]) @ _frame(mesh["placement"])
             assert np.abs(world - oMg).max() < 1e-9, (mesh["name"], k)
+    bodies = body_frames(arm, scenario.goal)  # kcplan's own chain, for the cover
+    for body, expected in zip(data["cover"], bodies, strict=True):
+        world = _frame(data["joint_frames"][-1][body["joint"]]) @ _frame(body["placement"])
+        assert np.abs(world - expected).max() < 1e-9, body["name"]
     starts = [_frame(r) for r in data["start_frames"]]
     assert np.abs(np.array(starts) - [_frame(r) for r in data["joint_frames"][0]]).max() < 1e-12
     assert data["labels"][0].endswith("(start)") and data["labels"][-1].endswith("(goal)")
@@ -162,6 +167,12 @@ var Plotly = {restyle: function (gd, update, traces) {
     assert np.abs(xyz - np.vstack(posed)).max() < 1e-9
     faces = np.column_stack([arm["update"][a][0] for a in "ijk"])
     assert len(faces) == sum(len(m.faces) for m in meshes) and faces.max() == len(xyz) - 1
+    cover = next(c for c in calls if c["traces"] == [3] and "i" in c["update"])
+    xyz = np.column_stack([cover["update"][a][0] for a in "xyz"])
+    bodies = cover_meshes(scenario.arm)
+    posed = [m.vertices @ T[:3, :3].T + T[:3, 3] for m, T in
+             zip(bodies, mesh_frames(bodies, frames)[0], strict=True)]  # fmt: skip
+    assert np.abs(xyz - np.vstack(posed)).max() < 1e-6  # the unit sphere is kept to 1e-6
     goal = next(c for c in calls if c["traces"] == [1])
     assert set(goal["update"]["facecolor"][0]) == {"#d62728"}
 
