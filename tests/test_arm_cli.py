@@ -119,7 +119,7 @@ def test_plan_then_verify_an_arm_path(scenario_file, tmp_path, capsys):
     assert code == 0, capsys.readouterr()
     assert "reach: solved by kc-rrtconnect" in capsys.readouterr().out
     data = json.loads(out.read_text())
-    assert data["joints"] == GROUP and data["backend"] == "python"
+    assert data["joints"] == GROUP and data["backend"] == "kernel"
     states = np.array(data["states"])
     assert states.shape[1] == 7 and np.allclose(states[0], READY)
     assert main(["verify", str(path), str(out)]) == 0
@@ -134,8 +134,8 @@ def test_plan_then_verify_an_arm_path(scenario_file, tmp_path, capsys):
     bad.write_text(json.dumps(data))
     assert main(["verify", str(path), str(bad)]) == 2
     assert "states[1]: expected joint values within the limits" in capsys.readouterr().err
-    assert main(["plan", str(path), "--html", str(tmp_path / "v.html")]) == 2
-    assert "--html: not available for arms yet" in capsys.readouterr().err
+    assert main(["plan", str(path), "--plot", str(tmp_path / "v.png"), "--guards"]) == 2
+    assert "--guards: not available for arms" in capsys.readouterr().err
 
 
 def test_verify_finds_a_path_through_the_board(scenario_file, tmp_path, capsys):
@@ -210,15 +210,11 @@ def test_bench_runs_and_verifies_arm_planners(tmp_path, capsys):
     assert all(r["collides"] is False and r["verify_queries"] > 0 for r in records)
 
 
-def test_the_views_and_the_rigid_world_refuse_arms_with_one_line(capsys):
-    from kcplan.viz import plot_scenario
+def test_the_rigid_world_refuses_arms_with_one_line(capsys):
     from kcplan.world import CollisionWorld
 
     box = ARM / "box_1.yaml"
-    assert main(["show", str(box)]) == 2
-    assert capsys.readouterr().err.strip() == f"{box}: show: arms are not drawn yet"
-    for call in (lambda: plot_scenario(box, "x.png"), lambda: CollisionWorld(box)):
-        with pytest.raises(TypeError, match="expected a rigid robot of ellipsoids, got an arm"):
-            call()
+    with pytest.raises(TypeError, match="expected a rigid robot of ellipsoids, got an arm"):
+        CollisionWorld(box)
     assert main(["validate", str(box)]) == 0
     assert "robot arm of 7 joints, 44 bodies (panda.urdf)" in capsys.readouterr().out

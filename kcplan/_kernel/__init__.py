@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from kcplan._kernel import _core
-from kcplan._kernel._core import EdgeCertifier, Robot, World
+from kcplan._kernel._core import ArmCertifier, ArmWorld, Chain, EdgeCertifier, Robot, World
 
 __all__ = [
     "COAL_CLEARANCE_ATOL",
@@ -47,7 +47,13 @@ __all__ = [
     "EdgeCertifier",
     "Robot",
     "World",
+    "ArmCertifier",
+    "ArmWorld",
+    "Chain",
+    "add_obstacles",
+    "build_kernel_arm",
     "build_kernel_world",
+    "kernel_chain",
     "kernel_robot",
 ]
 
@@ -111,7 +117,15 @@ def build_kernel_world(scenario, robot, half_height: float) -> _core.World:
     )
     atol = COAL_CLEARANCE_ATOL * size + COAL_CLEARANCE_FLOOR * (1.0 + ball)
     world = _core.World(kernel_robot(robot), float(half_height), COAL_CLEARANCE_RTOL, atol)
-    for ob in scenario.obstacles:
+    add_obstacles(world, scenario.obstacles, n)
+    world.finalize()
+    return world
+
+
+def add_obstacles(world: _core.World, obstacles, n: int) -> None:
+    """Add :class:`kcplan.world.scenario.Obstacle` s of an ``n``-D scene to a kernel world
+    (before its first query)."""
+    for ob in obstacles:
         centre = [float(v) for v in ob.center] + [0.0] * (3 - n)
         if ob.kind in ("polygon", "box") and n == 2:
             for piece in ob.pieces:
@@ -123,11 +137,51 @@ def build_kernel_world(scenario, robot, half_height: float) -> _core.World:
         elif ob.kind in ("ellipse", "ellipsoid"):
             axes = [float(v) for v in ob.extents]
             world.add_ellipsoid(centre, _embed(ob.rotation), axes if n == 3 else [*axes, min(axes)])
+        elif ob.kind == "cylinder":  # arm scenes; extents (r, r, h / 2)
+            world.add_cylinder(
+                centre, _embed(ob.rotation), float(ob.extents[0]), float(ob.extents[2])
+            )
         elif ob.kind == "convex":
             world.add_convex(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
         elif ob.kind == "mesh":
             world.add_mesh(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
         else:  # pragma: no cover - the scenario loader knows no other kind
             raise ValueError(f"{ob.label}: unknown obstacle kind {ob.kind!r}")
-    world.finalize()
-    return world
+
+
+def kernel_chain(arm) -> _core.Chain:
+    """The kernel's twin of an :class:`kcplan.arm.ArmModel`'s chain and bodies: the
+    reduced model's joint placements, axes and kinds (:func:`kcplan.arm.kinematics.
+    joint_axes`), each joint's place in the state, the limits and the covering bodies."""
+    from kcplan.arm.kinematics import joint_axes  # here: rigid users never load Pinocchio
+
+    model = arm.model
+    state_of = {int(i): j for j, i in enumerate(arm.q_index)}
+    axes = joint_axes(arm)
+    parents, placements, axis, prismatic, states = [], [], [], [], []
+    for i in range(1, model.njoints):
+        parents.append(int(model.parents[i]))
+        placements += np.asarray(model.jointPlacements[i].homogeneous, dtype=float).ravel().tolist()
+        axis += axes[i].tolist()
+        states.append(state_of[int(model.joints[i].idx_q)])
+        prismatic.append(arm.kinds[states[-1]] == "prismatic")
+    return _core.Chain(
+        parents, placements, axis, prismatic, states,
+        arm.lower.tolist(), arm.upper.tolist(),
+        [int(b.joint) for b in arm.bodies],
+        [float(v) for b in arm.bodies for v in b.placement.ravel()],
+        [float(v) for b in arm.bodies for v in b.semi_axes],
+    )  # fmt: skip
+
+
+def build_kernel_arm(world) -> _core.ArmWorld:
+    """The kernel's twin of an :class:`kcplan.arm.ArmWorld`: the same chain, bodies, self
+    pairs and obstacles, with coal's error allowance for a scene of the world's size
+    (:data:`COAL_CLEARANCE_ATOL`, :data:`COAL_CLEARANCE_FLOOR`)."""
+    ball = max((float(ob.extents[0]) for ob in world.obstacles if ob.kind == "sphere"), default=0.0)
+    atol = COAL_CLEARANCE_ATOL * world.size + COAL_CLEARANCE_FLOOR * (1.0 + ball)
+    pairs = [(int(k), int(m)) for k, m in world.self_pairs]
+    kernel = _core.ArmWorld(kernel_chain(world.arm), pairs, COAL_CLEARANCE_RTOL, atol)
+    add_obstacles(kernel.scene, world.obstacles, 3)
+    kernel.scene.finalize()
+    return kernel

@@ -6,6 +6,7 @@
 #include <nanobind/stl/unique_ptr.h>
 #include <nanobind/stl/vector.h>
 
+#include "arm_certifier.hpp"
 #include "certifier.hpp"
 
 namespace nb = nanobind;
@@ -74,6 +75,26 @@ nb::list guard_bodies(const kcplan::Guard& g) {
   return bodies;
 }
 
+std::vector<double> flat(const coal::Transform3s& t) {
+  const coal::Matrix3s& R = t.getRotation();
+  const coal::Vec3s& x = t.getTranslation();
+  return {R(0, 0), R(0, 1), R(0, 2), x[0], R(1, 0), R(1, 1), R(1, 2), x[1],
+          R(2, 0), R(2, 1), R(2, 2), x[2], 0.0,     0.0,     0.0,     1.0};
+}
+
+nb::list frames_of(const std::vector<coal::Transform3s>& frames) {
+  nb::list out;
+  for (const coal::Transform3s& t : frames) out.append(flat(t));
+  return out;
+}
+
+const double* joints_of(const kcplan::Chain& chain, const std::vector<double>& q) {
+  if (static_cast<int>(q.size()) != chain.dof())
+    throw std::invalid_argument("state: expected " + std::to_string(chain.dof()) +
+                                " joint values, got " + std::to_string(q.size()));
+  return q.data();
+}
+
 }  // namespace
 
 NB_MODULE(_core, m) {
@@ -102,6 +123,8 @@ NB_MODULE(_core, m) {
       .def("add_sphere", &kcplan::World::add_sphere, "centre"_a, "radius"_a)
       .def("add_ellipsoid", &kcplan::World::add_ellipsoid, "centre"_a, "rotation"_a,
            "extents"_a)
+      .def("add_cylinder", &kcplan::World::add_cylinder, "centre"_a, "rotation"_a, "radius"_a,
+           "half_height"_a)
       .def("add_mesh", &kcplan::World::add_mesh, "vertices"_a, "triangles"_a)
       .def("finalize", &kcplan::World::finalize)
       .def_prop_ro("n_objects", &kcplan::World::n_objects)
@@ -240,4 +263,91 @@ NB_MODULE(_core, m) {
       .def_prop_ro("occupancy", &kcplan::EdgeCertifier::occupancy)
       .def_prop_ro("probes", &kcplan::EdgeCertifier::probes)
       .def_prop_ro("discrete", &kcplan::EdgeCertifier::discrete);
+
+  nb::class_<kcplan::Chain>(m, "Chain")
+      .def(nb::init<const std::vector<int>&, const std::vector<double>&, const std::vector<double>&,
+                    const std::vector<bool>&, const std::vector<int>&, const std::vector<double>&,
+                    const std::vector<double>&, const std::vector<int>&,
+                    const std::vector<double>&, const std::vector<double>&>(),
+           "parents"_a, "placements"_a, "axes"_a, "prismatic"_a, "states"_a, "lower"_a,
+           "upper"_a, "body_joints"_a, "body_placements"_a, "semi_axes"_a)
+      .def_prop_ro("dof", &kcplan::Chain::dof)
+      .def_prop_ro("n_bodies", [](const kcplan::Chain& c) { return c.bodies().size(); })
+      .def_prop_ro("point_speeds", &kcplan::Chain::point_speeds)
+      .def_prop_ro("carries", &kcplan::Chain::carries)
+      .def("relative_speeds", &kcplan::Chain::relative_speeds, "pairs"_a)
+      .def("admits", [](const kcplan::Chain& c, const std::vector<double>& q) {
+        return c.admits(joints_of(c, q));
+      }, "q"_a)
+      .def("joint_frames", [](const kcplan::Chain& c, const std::vector<double>& q) {
+        std::vector<coal::Transform3s> frames;
+        c.joint_frames(joints_of(c, q), frames);
+        return frames_of(frames);
+      }, "q"_a)
+      .def("body_frames", [](const kcplan::Chain& c, const std::vector<double>& q) {
+        std::vector<coal::Transform3s> joints, frames;
+        c.body_frames(joints_of(c, q), joints, frames);
+        return frames_of(frames);
+      }, "q"_a);
+
+  nb::class_<kcplan::ArmWorld>(m, "ArmWorld")
+      .def(nb::init<const kcplan::Chain&, const std::vector<std::array<int, 2>>&, double, double>(),
+           "chain"_a, "pairs"_a, "rtol"_a, "atol"_a)
+      .def_prop_ro("scene", [](kcplan::ArmWorld& w) -> kcplan::World& { return w.scene(); },
+                   nb::rv_policy::reference_internal)
+      .def_prop_ro("chain", &kcplan::ArmWorld::chain, nb::rv_policy::reference_internal)
+      .def_prop_ro("n_pairs", [](const kcplan::ArmWorld& w) { return w.pairs().size(); })
+      .def("in_collision", [](kcplan::ArmWorld& w, const std::vector<double>& q) {
+        return w.in_collision(joints_of(w.chain(), q));
+      }, "q"_a)
+      .def("safe_clearances", [](kcplan::ArmWorld& w, const std::vector<double>& q) {
+        std::vector<double> scene(w.chain().bodies().size()), pairs(w.pairs().size());
+        w.safe_clearances(joints_of(w.chain(), q), scene.data(), pairs.data());
+        return nb::make_tuple(scene, pairs);
+      }, "q"_a)
+      .def_prop_ro("counters", [](kcplan::ArmWorld& w) {
+        nb::dict d = world_counters(w.scene());
+        d["pair_queries"] = w.pair_queries;
+        return d;
+      })
+      .def("reset_counters", [](kcplan::ArmWorld& w) {
+        w.scene().counters = kcplan::WorldCounters{};
+        std::fill(w.scene().body_query_counts.begin(), w.scene().body_query_counts.end(), 0);
+        w.pair_queries = 0;
+      });
+
+  nb::class_<kcplan::ArmCertifier>(m, "ArmCertifier")
+      .def(
+          "__init__",
+          [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
+             std::size_t cache_entries) {
+            kcplan::ArmCertifierOptions o;
+            o.max_guards = max_guards, o.cache_entries = cache_entries;
+            new (self) kcplan::ArmCertifier(world, o);
+          },
+          "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, nb::keep_alive<1, 2>())
+      .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
+                       const std::vector<double>& q2) {
+        const kcplan::Chain& chain = c.world().chain();
+        return c.check(joints_of(chain, q1), joints_of(chain, q2));
+      }, "q1"_a, "q2"_a)
+      .def("state_valid", [](kcplan::ArmCertifier& c, const std::vector<double>& q) {
+        return c.state_valid(joints_of(c.world().chain(), q));
+      }, "q"_a)
+      .def("measure", [](kcplan::ArmCertifier& c, const std::vector<double>& q) {
+        const kcplan::ArmGuard g = c.measure(joints_of(c.world().chain(), q));
+        return nb::make_tuple(g.clearance, g.scene, g.pairs);
+      }, "q"_a)
+      .def_prop_ro("counters", [](const kcplan::ArmCertifier& c) {
+        nb::dict d = certifier_counters(c.counters);
+        d["refined_pairs"] = c.refined_pairs;
+        return d;
+      })
+      .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {
+        nb::dict d;
+        d["ball"] = c.covered_ball;
+        return d;
+      })
+      .def_prop_ro("cache_size", [](const kcplan::ArmCertifier& c) { return c.cache().size(); })
+      .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards);
 }

@@ -191,33 +191,19 @@ bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {
 
 bool EdgeCertifier::advance(const Edge& edge, double lo, double hi) {
   CertifierCounters& c = counters;
-  pending_.clear();
-  pending_.emplace_back(lo, hi);
   int guards = 0;
-  while (!pending_.empty()) {
-    const auto [s0, s1] = pending_.back();
-    pending_.pop_back();
-    if (guards >= max_guards_) {
-      c.bisection_nodes += guards;
-      return reject(c.not_proven);
-    }
-    const double m = 0.5 * (s0 + s1);
-    const Guard guard = measure(edge.pose(m));
-    ++guards;
-    if (guard.clearance <= 0.0) {
-      c.bisection_nodes += guards;
-      return reject(c.rejected_guard);
-    }
-    double g_lo, g_hi;
-    reach(guard, edge, m, s0, s1, g_lo, g_hi);
-    if (g_hi - g_lo <= 1e-12) {
-      c.bisection_nodes += guards;
-      return reject(c.not_proven);
-    }
-    if (g_lo > s0) pending_.emplace_back(s0, g_lo);
-    if (g_hi < s1) pending_.emplace_back(g_hi, s1);
-  }
+  const Advanced outcome = kcplan::advance(
+      lo, hi, max_guards_, pending_,
+      [&](double m, double s0, double s1, double& g_lo, double& g_hi) {
+        const Guard guard = measure(edge.pose(m));
+        if (guard.clearance <= 0.0) return false;
+        reach(guard, edge, m, s0, s1, g_lo, g_hi);
+        return true;
+      },
+      guards);
   c.bisection_nodes += guards;
+  if (outcome == Advanced::kRejected) return reject(c.rejected_guard);
+  if (outcome == Advanced::kNotProven) return reject(c.not_proven);
   c.certified_one_guard += guards == 1;
   return true;
 }

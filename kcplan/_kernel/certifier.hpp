@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "advancement.hpp"
 #include "certificates.hpp"
 #include "domain.hpp"
 #include "guard.hpp"

@@ -92,35 +92,39 @@ struct Guard {
   }
 };
 
-/// Guards and validity of states, keyed by the exact bits of their flat pose.
+/// Guards and validity of states, keyed by the exact bits of their N numbers.
 ///
 /// OMPL copies states bit for bit, so a state handed back has exactly the numbers it had
-/// when it was measured, and a different pose can never hit another's entry. At most
+/// when it was measured, and a different state can never hit another's entry. At most
 /// `max_entries` guards and as many validity marks are kept; when a table is full the
-/// oldest quarter of it is dropped.
-class GuardCache {
+/// oldest quarter of it is dropped. `Value` is the guard type; it has a `clearance`
+/// (> 0: the state is free). Rigid robots key by their flat pose (GuardCache), arms by
+/// their joint vector (ArmGuardCache in arm_certifier.hpp).
+template <std::size_t N, class Value>
+class StateCache {
  public:
-  using Key = std::array<std::uint64_t, 7>;
+  using Key = std::array<std::uint64_t, N>;
 
-  explicit GuardCache(std::size_t max_entries = 200000) : max_entries_(max_entries) {
+  explicit StateCache(std::size_t max_entries = 200000) : max_entries_(max_entries) {
     if (max_entries == 0) throw std::invalid_argument("max_entries: expected at least 1");
   }
 
-  static Key key(const Pose& pose) {
+  /// The key of `count` <= N numbers (the rest zero).
+  static Key key_of(const double* values, std::size_t count) {
     Key k{};
-    std::memcpy(k.data(), pose.raw.data(), sizeof(double) * pose.size);
+    std::memcpy(k.data(), values, sizeof(double) * count);
     return k;
   }
 
-  /// The guard measured at this pose, or null. Shared: a guard dropped from a full cache
+  /// The guard measured at this state, or null. Shared: a guard dropped from a full cache
   /// stays alive for whoever still holds it.
-  std::shared_ptr<const Guard> guard(const Key& key) const {
+  std::shared_ptr<const Value> guard(const Key& key) const {
     auto it = guards_.find(key);
     return it == guards_.end() ? nullptr : it->second;
   }
-  std::shared_ptr<const Guard> add_guard(const Key& key, Guard guard) {
+  std::shared_ptr<const Value> add_guard(const Key& key, Value guard) {
     bound(guards_, guard_order_);
-    auto stored = std::make_shared<const Guard>(std::move(guard));
+    auto stored = std::make_shared<const Value>(std::move(guard));
     auto [it, inserted] = guards_.insert_or_assign(key, stored);
     (void)it;
     if (inserted) guard_order_.push_back(key);
@@ -161,9 +165,16 @@ class GuardCache {
   }
 
   std::size_t max_entries_;
-  std::unordered_map<Key, std::shared_ptr<const Guard>, Hash> guards_;
+  std::unordered_map<Key, std::shared_ptr<const Value>, Hash> guards_;
   std::unordered_map<Key, bool, Hash> valid_;
   std::deque<Key> guard_order_, valid_order_;
+};
+
+/// The guards of a rigid robot, keyed by its flat pose.
+class GuardCache : public StateCache<7, Guard> {
+ public:
+  using StateCache::StateCache;
+  static Key key(const Pose& pose) { return key_of(pose.raw.data(), pose.size); }
 };
 
 }  // namespace kcplan

@@ -33,15 +33,17 @@ struct Body {
   double reach() const { return offset() + a_max; }
 };
 
-/// The robot: at most 32 bodies of one dimension. Body k at the robot pose (R, t) has the
-/// world pose (R R_k, t + R p_k).
+/// The robot: at most 32 bodies of one dimension (an arm's bodies, each placed by its own
+/// frame, up to kMaxArmBodies). Body k at the robot pose (R, t) has the world pose
+/// (R R_k, t + R p_k).
 class Robot {
  public:
-  static constexpr int kMaxBodies = 32;
+  static constexpr int kMaxBodies = 32, kMaxArmBodies = 1024;
 
   /// `semi_axes` and `poses` hold one row per body: `dimension` semi-axes, and the body's
   /// flat pose in the robot frame ([x, y, yaw] or [x, y, z, qx, qy, qz, qw]).
-  Robot(int dimension, const std::vector<double>& semi_axes, const std::vector<double>& poses)
+  Robot(int dimension, const std::vector<double>& semi_axes, const std::vector<double>& poses,
+        int max_bodies = kMaxBodies)
       : dimension_(dimension) {
     const int size = pose_size(dimension);
     const std::size_t count = semi_axes.size() / dimension;
@@ -49,9 +51,9 @@ class Robot {
       throw std::invalid_argument("robot: expected " + std::to_string(dimension) +
                                   " semi-axes and " + std::to_string(size) +
                                   " pose numbers per body");
-    if (count > static_cast<std::size_t>(kMaxBodies))
-      throw std::invalid_argument("robot: expected at most 32 bodies, got " +
-                                  std::to_string(count));
+    if (count > static_cast<std::size_t>(max_bodies))
+      throw std::invalid_argument("robot: expected at most " + std::to_string(max_bodies) +
+                                  " bodies, got " + std::to_string(count));
     for (std::size_t k = 0; k < count; ++k) {
       Body b;
       b.a_max = 0.0, b.a_min = INFINITY;

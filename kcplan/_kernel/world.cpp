@@ -1,5 +1,7 @@
 #include "world.hpp"
 
+#include "coal_requests.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -95,31 +97,6 @@ struct Collect : coal::CollisionCallBackBase {
     return false;  // keep going: every piece in the box
   }
 };
-
-/// GJK settings of every distance query. coal's relative tolerance 1e-6 (its default,
-/// fixed here because the error allowance was measured with it): at 1e-4 coal's distances
-/// exceeded python-fcl's by up to 7.6e-3 relative on window_wall, above the allowance;
-/// Nesterov acceleration was 6x slower against large boxes.
-///
-/// Every query starts GJK from the pair's warm start (CachedGuess), set per pair.
-coal::DistanceRequest distance_request(bool nearest_points) {
-  // an overlap only needs to be known (clearance 0), not measured: no EPA
-  coal::DistanceRequest request(nearest_points, /*enable_signed_distance=*/false);
-  request.gjk_tolerance = 1e-6;
-  request.gjk_initial_guess = coal::GJKInitialGuess::CachedGuess;
-  return request;
-}
-
-/// A yes/no collision request: no contact (so no EPA on an overlap), and GJK may stop as
-/// soon as it proves a pair apart (distance > 0) instead of converging on the distance,
-/// which coal's default (no bound) does.
-coal::CollisionRequest collision_request() {
-  coal::CollisionRequest request(coal::NO_REQUEST, 1);
-  request.enable_contact = false;
-  request.distance_upper_bound = 0.0;
-  request.gjk_initial_guess = coal::GJKInitialGuess::CachedGuess;
-  return request;
-}
 
 }  // namespace
 
@@ -331,6 +308,17 @@ void World::add_ellipsoid(const std::array<double, 3>& centre,
       std::move(support));
 }
 
+void World::add_cylinder(const std::array<double, 3>& centre,
+                         const std::array<double, 9>& rotation, double radius,
+                         double half_height) {
+  require_finite(centre.data(), 3, "cylinder");
+  require_finite(rotation.data(), 9, "cylinder");
+  const double sizes[2] = {radius, half_height};
+  require_positive(sizes, 2, "cylinder: expected a positive finite radius and height");
+  add(std::make_shared<coal::Cylinder>(radius, 2.0 * half_height),
+      coal::Transform3s(matrix(rotation), vec(centre)), Support{});
+}
+
 void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles) {
   std::vector<Vec3s> points = points_of(vertices, "mesh");
   std::vector<coal::Triangle> faces = triangles_of(triangles, points.size(), "mesh");
@@ -420,8 +408,20 @@ double World::distance(coal::CollisionObject& object, std::size_t shape) {
   return near.best;
 }
 
+void World::place_bodies(const coal::Transform3s* frames) {
+  if (!finalized_) finalize();
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    bodies_[k]->setTransform(frames[k]);
+    bodies_[k]->computeAABB();
+  }
+}
+
 bool World::in_collision(const Pose& pose) {
   place(pose);
+  return bodies_collide();
+}
+
+bool World::bodies_collide() {
   ++counters.collision_queries;
   if (objects_.empty()) return false;
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
@@ -433,6 +433,10 @@ bool World::in_collision(const Pose& pose) {
 
 void World::body_distances(const Pose& pose, double* out) {
   place(pose);
+  bodies_distances(out);
+}
+
+void World::bodies_distances(double* out) {
   ++counters.distance_queries;
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     if (objects_.empty()) {
@@ -445,9 +449,13 @@ void World::body_distances(const Pose& pose, double* out) {
 }
 
 void World::safe_body_clearances(const Pose& pose, double* out) {
-  body_distances(pose, out);
-  for (std::size_t k = 0; k < bodies_.size(); ++k)
-    out[k] = std::max(out[k] * (1.0 - rtol_) - atol_, 0.0);
+  place(pose);
+  bodies_safe_clearances(out);
+}
+
+void World::bodies_safe_clearances(double* out) {
+  bodies_distances(out);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = safe(out[k]);
 }
 
 bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out) {

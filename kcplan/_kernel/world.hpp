@@ -94,6 +94,11 @@ class World {
   /// An ellipsoid {c + R diag(e) u}; in 2D pass (e1, e2, min(e)) and R embedding the yaw.
   void add_ellipsoid(const std::array<double, 3>& centre, const std::array<double, 9>& rotation,
                      const std::array<double, 3>& extents);
+  /// A cylinder of `radius` about its local z axis, |z| <= half_height, centred at
+  /// `centre` and rotated by `rotation` (arm scenes; like a mesh it has no support
+  /// function: region queries keep only its clearance).
+  void add_cylinder(const std::array<double, 3>& centre, const std::array<double, 9>& rotation,
+                    double radius, double half_height);
   /// A triangle mesh surface (no support function: its pieces keep only clearances).
   void add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles);
   /// Register every obstacle in the broad phase (once, after the last add_*).
@@ -113,6 +118,19 @@ class World {
   /// as horizon. Returns false, with every region empty and of horizon 0, as soon as a
   /// piece touches a body.
   bool free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out);
+  // -- the same queries for bodies placed one by one (an arm: each body by its own frame) --
+  /// Place body k at `frames[k]` (world frame; one frame per body, finite).
+  void place_bodies(const coal::Transform3s* frames);
+  /// in_collision for the bodies as placed.
+  bool bodies_collide();
+  /// body_distances for the bodies as placed.
+  void bodies_distances(double* out);
+  /// safe_body_clearances for the bodies as placed.
+  void bodies_safe_clearances(double* out);
+  /// A distance reduced by the error allowance, d (1 - rtol) - atol, at least 0: what a
+  /// coal distance certainly is (never an overestimate).
+  double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
+
   /// Whether the ball of `radius` about `centre` (z = 0 in 2D) meets an obstacle.
   bool ball_collides(const std::array<double, 3>& centre, double radius);
   /// Whether the capsule of `radius` about the segment a -> b meets an obstacle.

@@ -1,11 +1,12 @@
-"""The compiled edge certifier behind the Python certifier's interface.
+"""The compiled edge certifiers behind the Python certifiers' interface.
 
 :class:`KernelCertifier` runs :class:`kcplan._kernel.EdgeCertifier` (C++, on coal) on the
 kernel twin of a :class:`kcplan.world.CollisionWorld` and answers exactly what
 :class:`kcplan.planning.certifier.EdgeCertifier` answers: ``check``, ``state_valid``,
 ``counters`` and ``covered`` under the same names. It holds no logic of its own; the
 decision is made in ``kcplan/_kernel/certifier.cpp``, whose Python twin is
-:mod:`kcplan.planning.certifier`.
+:mod:`kcplan.planning.certifier`. :class:`KernelArmCertifier` does the same for arms
+(``kcplan/_kernel/arm_certifier.cpp``, twin :mod:`kcplan.planning.arm_certifier`).
 """
 
 from __future__ import annotations
@@ -15,11 +16,12 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from kcplan._kernel import ArmCertifier as _CompiledArmCertifier
 from kcplan._kernel import EdgeCertifier as _CompiledCertifier
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
 from kcplan.planning.ladder import GuardLadder
 
-__all__ = ["KernelCertifier"]
+__all__ = ["KernelArmCertifier", "KernelCertifier"]
 
 
 class KernelCertifier:
@@ -134,3 +136,51 @@ class KernelCertifier:
 
 def _flat(pose: ArrayLike) -> list[float]:
     return np.asarray(pose, dtype=float).ravel().tolist()
+
+
+class KernelArmCertifier:
+    """:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`'s decisions, made in C++.
+
+    Parameters
+    ----------
+    world : kcplan.arm.ArmWorld
+        Its :attr:`~kcplan.arm.ArmWorld.kernel` is used (built on first use); the
+        certifier's queries show in ``world.counters``.
+    max_guards, cache_entries
+        As for :class:`~kcplan.planning.arm_certifier.ArmEdgeCertifier`.
+
+    Notes
+    -----
+    ``counters`` adds ``refined_pairs``: self pairs whose bounding balls' gap limited a
+    guard's radius, so that coal measured their distance. Not thread-safe.
+    """
+
+    backend = "kernel"
+    certificates = ("ball",)
+    fallback = "bisection"
+
+    def __init__(self, world, max_guards: int = 256, cache_entries: int = 200_000):
+        self.world = world
+        self.n = world.arm.dof
+        self.compiled = _CompiledArmCertifier(world.kernel, int(max_guards), int(cache_entries))
+
+    def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
+        """True when the whole edge is proven free (``resolution`` is unused: arms have
+        no discrete fallback)."""
+        return self.compiled.check(_joints(state1), _joints(state2))
+
+    def state_valid(self, state: ArrayLike) -> bool:
+        """One collision query for a state not seen before (remembered)."""
+        return self.compiled.state_valid(_joints(state))
+
+    @property
+    def counters(self) -> dict:
+        return self.compiled.counters
+
+    @property
+    def covered(self) -> dict:
+        return self.compiled.covered
+
+
+def _joints(state: ArrayLike) -> list[float]:
+    return np.asarray(state, dtype=float).ravel().tolist()

@@ -461,7 +461,7 @@ class _Setup:
     read: Callable
     write: Callable
     backend: str
-    """Who checks: ``"kernel"`` or ``"python"`` (arms: python-fcl, for now)."""
+    """Who checks: ``"kernel"`` (compiled, on coal) or ``"python"`` (python-fcl)."""
     joints: tuple[str, ...] | None = None
     """An arm's planning group (the states' order); None for a rigid robot."""
 
@@ -502,8 +502,9 @@ def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | 
 
 
 def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
-    """The group's joint box (the limits); the covers' python-fcl queries. For arms the
-    ``kc-*`` and ``ca-*`` planners both certify with the chain's clearance balls
+    """The group's joint box (the limits); the covers' collision queries, compiled
+    (``backend="kernel"``, on coal) or on python-fcl. For arms the ``kc-*`` and ``ca-*``
+    planners both certify with the chain's clearance balls
     (:mod:`kcplan.planning.arm_certifier`); stock planners check states discretely."""
     arm = scenario.arm
     if world is None:
@@ -513,18 +514,25 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     ss = og.SimpleSetup(space)
     si = ss.getSpaceInformation()
     validator = None
+    n = arm.dof
     if spec.kc:
-        validator = KCMotionValidator(si, arm, world)
+        validator = KCMotionValidator(si, arm, world, backend=spec.backend)
         si.setMotionValidator(validator)
         state_valid = validator.state_valid
     elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand
         from kcplan.planning.pin_checker import PinChecker
 
         state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
+    elif spec.backend == "kernel":
+        kernel, admits = world.kernel, world.kernel.chain.admits
+
+        def state_valid(state) -> bool:
+            q = [state[j] for j in range(n)]
+            return admits(q) and not kernel.in_collision(q)
     else:
 
         def state_valid(state) -> bool:
-            q = joint_state(state, arm.dof)
+            q = joint_state(state, n)
             return arm.within_limits(q) and not world.in_collision(q)
 
     if spec.joint_step is not None:  # at most joint_step between checked states (L2, rad)
@@ -532,5 +540,5 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
 
     return _Setup(
         space, ss, si, world, validator, state_valid,
-        lambda state: joint_state(state, arm.dof), set_joint_state, "python", arm.joints,
+        lambda state: joint_state(state, n), set_joint_state, spec.backend, arm.joints,
     )  # fmt: skip

@@ -42,7 +42,7 @@ from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
 from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
-from kcplan.planning.kernel import KernelCertifier
+from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import joint_state, state_pose
 from kcplan.world.collision import CollisionWorld
@@ -158,19 +158,34 @@ class KCMotionValidator(ob.MotionValidator):
     def _init_arm(self, arm, world, certificates, fallback, max_guards, backend) -> None:
         if arm is not world.arm:
             raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
-        if backend not in (None, "python"):
-            raise ValueError(
-                f"backend: arms are decided by the Python certifier for now, got {backend!r}"
-            )
+        backend = "kernel" if backend is None else backend
+        if backend not in ("kernel", "python"):
+            raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
         if certificates not in (None, ("ball",), ["ball"]) or fallback != "bisection":
             raise ValueError(
                 "certificates: arms have the clearance ball ('ball', bisection) for now, "
                 f"got {certificates!r} with {fallback!r}"
             )
-        self.certifier = ArmEdgeCertifier(world, 256 if max_guards is None else max_guards)
-        self.backend = "python"
+        max_guards = 256 if max_guards is None else max_guards
+        if backend == "kernel":
+            self.certifier = KernelArmCertifier(world, max_guards)
+            compiled, n = self.certifier.compiled, arm.dof
+            # the hot path: one call into the kernel with the two joint vectors
+            self.state_valid = lambda s: compiled.state_valid([s[j] for j in range(n)])
+            self.checkMotion = self._check_kernel_arm
+        else:
+            self.certifier = ArmEdgeCertifier(world, max_guards)
+        self.backend = backend
         self.n = arm.dof
         self._read = lambda state, n=arm.dof: joint_state(state, n)
+
+    def _check_kernel_arm(self, s1, s2) -> bool:
+        try:
+            n, check = self.n, self.certifier.compiled.check
+            q1, q2 = [s1[j] for j in range(n)], [s2[j] for j in range(n)]
+            return self.error is None and check(q1, q2)
+        except Exception as err:  # noqa: BLE001 - see checkMotion
+            return self._fail(err)
 
     @property
     def counters(self) -> dict:

@@ -1,0 +1,146 @@
+#include "arm_certifier.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "advancement.hpp"
+
+namespace kcplan {
+
+ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
+    : world_(world),
+      chain_(world.chain()),
+      n_(world.chain().dof()),
+      max_guards_(options.max_guards),
+      cache_(options.cache_entries),
+      rho_(world.chain().point_speeds()),
+      rho_pairs_(world.chain().relative_speeds(world.pairs())) {
+  if (max_guards_ < 1) throw std::invalid_argument("max_guards: expected at least 1");
+  speed_.resize(chain_.bodies().size());
+  pair_speed_.resize(world.pairs().size());
+  q_.resize(n_);
+}
+
+bool ArmCertifier::reject(std::int64_t& reason) {
+  ++counters.rejected;
+  ++reason;
+  return false;
+}
+
+bool ArmCertifier::state_valid(const double* q) {
+  if (!chain_.admits(q)) return false;
+  const ArmGuardCache::Key key = ArmGuardCache::key_of(q, n_);
+  int known = cache_.validity(key);
+  if (known < 0) {
+    ++counters.collision_queries;
+    known = !world_.in_collision(q);
+    cache_.add_validity(key, known);
+  }
+  return known == 1;
+}
+
+ArmGuard ArmCertifier::measure(const double* q) {
+  ++counters.guards;
+  ArmGuard g;
+  std::copy(q, q + n_, g.q.begin());
+  const std::size_t bodies = chain_.bodies().size(), pairs = world_.pairs().size();
+  g.scene.resize(bodies);
+  g.pairs.resize(pairs);
+  g.exact.assign(pairs, 0);
+  const std::vector<coal::Transform3s>& frames = world_.place(q);
+  world_.scene_clearances(g.scene.data());
+  g.clearance = std::numeric_limits<double>::infinity();
+  for (double d : g.scene) g.clearance = std::min(g.clearance, d);
+  for (std::size_t m = 0; m < pairs; ++m) {
+    g.pairs[m] = world_.pair_gap(m, frames);
+    if (g.pairs[m] <= 0.0) {  // the balls meet: only GJK can tell whether the bodies do
+      g.pairs[m] = world_.pair_clearance(m, frames);
+      g.exact[m] = 1;
+    }
+    g.clearance = std::min(g.clearance, g.pairs[m]);
+  }
+  return g;
+}
+
+double ArmCertifier::radius(const ArmGuard& guard, const std::vector<double>& speed,
+                            const std::vector<double>& pair_speed) {
+  if (guard.clearance <= 0.0) return 0.0;
+  double r = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < speed.size(); ++k)
+    if (speed[k] > 0.0) r = std::min(r, guard.scene[k] / speed[k]);
+  bool placed = false;
+  for (std::size_t m = 0; m < pair_speed.size(); ++m) {
+    const double v = pair_speed[m];
+    if (!(v > 0.0) || guard.pairs[m] >= r * v) continue;
+    if (!guard.exact[m]) {  // the balls' gap limits r: ask for the distance itself
+      if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
+      guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames_));
+      guard.exact[m] = 1;
+      ++refined_pairs;
+    }
+    r = std::min(r, guard.pairs[m] / v);
+  }
+  return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
+}
+
+std::shared_ptr<const ArmGuard> ArmCertifier::endpoint(const double* q,
+                                                       const ArmGuardCache::Key& key) {
+  if (auto g = cache_.guard(key)) {
+    ++counters.cached_guards;
+    return g;
+  }
+  ++counters.endpoint_guards;
+  return cache_.add_guard(key, measure(q));
+}
+
+bool ArmCertifier::check(const double* q1, const double* q2) {
+  CertifierCounters& c = counters;
+  ++c.edges;
+  if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
+  if (!state_valid(q2)) return reject(c.rejected_end_state);
+  const std::size_t dof = n_;
+  for (std::size_t j = 0; j < dof; ++j) q_[j] = std::abs(q2[j] - q1[j]);
+  for (std::size_t k = 0; k < speed_.size(); ++k) {
+    double v = 0.0;
+    for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * q_[j];
+    speed_[k] = v;
+  }
+  for (std::size_t m = 0; m < pair_speed_.size(); ++m) {
+    double v = 0.0;
+    for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * q_[j];
+    pair_speed_[m] = v;
+  }
+  const double lo = radius(*endpoint(q1, ArmGuardCache::key_of(q1, n_)), speed_, pair_speed_);
+  if (lo <= 0.0) return reject(c.rejected_guard);
+  const double hi =
+      1.0 - radius(*endpoint(q2, ArmGuardCache::key_of(q2, n_)), speed_, pair_speed_);
+  if (hi >= 1.0) return reject(c.rejected_end_state);
+  if (lo >= hi) {
+    ++c.certified_by_endpoints;
+    covered_ball += 1.0;
+    return true;
+  }
+  std::vector<double> q(n_);
+  int guards = 0;
+  const Advanced outcome = advance(
+      lo, hi, max_guards_, pending_,
+      [&](double m, double, double, double& g_lo, double& g_hi) {
+        for (int j = 0; j < n_; ++j) q[j] = q1[j] + m * (q2[j] - q1[j]);
+        const double r = radius(measure(q.data()), speed_, pair_speed_);
+        if (r <= 0.0) return false;
+        g_lo = m - r, g_hi = m + r;
+        return true;
+      },
+      guards);
+  c.bisection_nodes += guards;
+  if (outcome == Advanced::kRejected) return reject(c.rejected_guard);
+  if (outcome == Advanced::kNotProven) return reject(c.not_proven);
+  c.certified_one_guard += guards == 1;
+  covered_ball += 1.0;
+  return true;
+}
+
+}  // namespace kcplan

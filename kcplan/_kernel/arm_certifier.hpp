@@ -1,0 +1,96 @@
+// The edge certifier of arms: joint-space edges proved free by the chain's clearance balls.
+// Python twin: kcplan/planning/arm_certifier.py (ArmEdgeCertifier); both decide every edge
+// by the same steps and count them under the rigid certifier's names.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "arm_world.hpp"
+#include "certifier.hpp"
+#include "guard.hpp"
+
+namespace kcplan {
+
+/// One guard of an arm: what one distance query at the state q proves.
+///
+/// `scene[k]` is body k's certain clearance to the obstacles; `pairs[m]` a certain lower
+/// bound of self pair m's distance, first the bounding balls' gap (ArmWorld::pair_gap),
+/// raised to the pair's GJK distance the first time a certificate needs more (`exact`).
+/// Raising a lower bound never makes it wrong, so a cached guard may be refined in place.
+struct ArmGuard {
+  std::array<double, Chain::kMaxJoints> q{};
+  std::vector<double> scene;
+  mutable std::vector<double> pairs;
+  mutable std::vector<char> exact;
+  double clearance = 0.0;  ///< > 0: the state is free (the smallest bound, once exact)
+};
+
+/// The guards of an arm, keyed by the joint vector.
+using ArmGuardCache = StateCache<Chain::kMaxJoints, ArmGuard>;
+
+/// Options of an ArmCertifier; the defaults are the Python certifier's.
+struct ArmCertifierOptions {
+  int max_guards = 256;  ///< guards per edge after the endpoints before "not proven"
+  std::size_t cache_entries = 200000;
+};
+
+/// Prove joint-space edges of an arm free, or reject them.
+///
+/// For the straight edge q(s) = q1 + s (q2 - q1), no point of body k moves faster than
+/// v_k = sum_j rho[k, j] |dq_j| per unit of s and no two points of a self pair (k, l)
+/// approach faster than v_kl (Chain::point_speeds, Chain::relative_speeds; Schwarzer, Saha
+/// and Latombe 2005). A guard at s = m with clearances d_k and d_kl therefore proves the
+/// open stretch |s - m| < r, r = min(min_k d_k / v_k, min_kl d_kl / v_kl), free: each
+/// body stays clear of the scene and of each body it may collide with, and the covers
+/// hold the links. kcplan/planning/arm_certifier.py has the proof in full.
+///
+/// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
+/// outside the limits or not finite rejects the edge with no query; (2) q2's validity
+/// (one collision query, cached); (3) guards at both ends (cached per state); (4) a guard
+/// in the middle of each stretch left open until none is (certified), one is in contact
+/// (rejected) or max_guards were placed ("not proven", rejected). A self pair's exact
+/// distance is asked only when its balls' gap would limit a radius: the radius is then
+/// exactly the one of exact distances. Not thread-safe (the world's objects are reused).
+class ArmCertifier {
+ public:
+  ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options);
+  ArmCertifier(const ArmCertifier&) = delete;
+  ArmCertifier& operator=(const ArmCertifier&) = delete;
+
+  /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free.
+  bool check(const double* q1, const double* q2);
+  /// State validity with the cache: one collision query for a state not seen before.
+  bool state_valid(const double* q);
+  /// One guard at q, not cached.
+  ArmGuard measure(const double* q);
+  /// The half width, in s, of the stretch `guard` proves free for the speeds (refines
+  /// the guard's pair bounds where they limit it).
+  double radius(const ArmGuard& guard, const std::vector<double>& speed,
+                const std::vector<double>& pair_speed);
+
+  ArmWorld& world() { return world_; }
+  const ArmGuardCache& cache() const { return cache_; }
+  int max_guards() const { return max_guards_; }
+  double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
+  CertifierCounters counters;
+  std::int64_t refined_pairs = 0;  ///< pair bounds raised to their GJK distance
+
+ private:
+  std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);
+  bool reject(std::int64_t& reason);
+
+  ArmWorld& world_;
+  const Chain& chain_;
+  int n_, max_guards_;
+  ArmGuardCache cache_;
+  std::vector<double> rho_, rho_pairs_;
+  std::vector<double> speed_, pair_speed_, q_;
+  std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
+  std::vector<std::pair<double, double>> pending_;
+};
+
+}  // namespace kcplan

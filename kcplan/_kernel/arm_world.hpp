@@ -1,0 +1,76 @@
+// The scene of an arm: its covering bodies, placed by the chain, against the obstacles
+// (a World) and against each other (the self pairs that may collide).
+// Python twin: kcplan/arm/world.py (ArmWorld, on python-fcl).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <coal/collision_data.h>
+#include <coal/collision_object.h>
+
+#include "chain.hpp"
+#include "world.hpp"
+
+namespace kcplan {
+
+/// Collision and clearance queries of an arm at a joint configuration.
+///
+/// The obstacles live in `scene()`, a World whose bodies are the chain's (added with its
+/// add_* methods, before the first query); the self pairs are (k, l) body indices that may
+/// collide. A pair is first tested by the bodies' bounding balls (centre, largest
+/// semi-axis): balls apart, bodies apart; only pairs whose balls meet go to coal's GJK.
+///
+/// Contract: a configuration has chain().dof() finite numbers (std::invalid_argument
+/// otherwise; limits are the certifier's business). Distances of safe_* queries are
+/// reduced by the scene's error allowance (World::safe) and never overestimate.
+/// Not thread-safe: the bodies' coal objects and the frames are reused.
+class ArmWorld {
+ public:
+  ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pairs, double rtol,
+           double atol);
+  ArmWorld(const ArmWorld&) = delete;
+  ArmWorld& operator=(const ArmWorld&) = delete;
+
+  const Chain& chain() const { return chain_; }
+  World& scene() { return *scene_; }
+  const std::vector<std::array<int, 2>>& pairs() const { return pairs_; }
+
+  /// Whether a body at q touches an obstacle or a body it may collide with (one
+  /// collision query).
+  bool in_collision(const double* q);
+  /// Certain clearances at q: of each body to the obstacles (`scene`, one per body, inf
+  /// with no obstacles) and of each self pair (`pairs`, one per pair), 0 on contact (one
+  /// distance query).
+  void safe_clearances(const double* q, double* scene, double* pairs);
+
+  /// Place the bodies at q (no query) and return their frames; valid until the next
+  /// place().
+  const std::vector<coal::Transform3s>& place(const double* q);
+  /// Certain clearance of each body to the obstacles, as placed (one distance query).
+  void scene_clearances(double* out) { scene_->bodies_safe_clearances(out); }
+  /// A certain lower bound of self pair m's distance with the bodies at `frames`: the
+  /// gap between their bounding balls, less rounding (<= 0: nothing known).
+  double pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;
+  /// Self pair m's certain distance with the bodies at `frames` (coal's GJK, warm-started
+  /// where the pair's last query ended, reduced by the allowance; 0 on contact).
+  double pair_clearance(std::size_t m, const std::vector<coal::Transform3s>& frames);
+
+  WorldCounters& counters() { return scene_->counters; }
+  std::int64_t pair_queries = 0;  ///< self pairs that went to GJK
+
+ private:
+  bool pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames);
+
+  Chain chain_;
+  std::vector<std::array<int, 2>> pairs_;
+  std::unique_ptr<World> scene_;
+  std::vector<std::shared_ptr<coal::CollisionGeometry>> shapes_;
+  std::vector<coal::Transform3s> joints_, frames_;
+  std::vector<coal::Vec3s> guesses_;  // per pair: where its last GJK ended
+  std::vector<coal::support_func_guess_t> hints_;
+};
+
+}  // namespace kcplan

@@ -1,0 +1,143 @@
+#include "chain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Geometry>
+
+namespace kcplan {
+namespace {
+
+coal::Transform3s transform_of(const double* h, const char* what) {
+  for (int i = 0; i < 16; ++i)
+    if (!std::isfinite(h[i])) throw std::invalid_argument(std::string(what) + ": expected finite numbers");
+  coal::Matrix3s R;
+  R << h[0], h[1], h[2], h[4], h[5], h[6], h[8], h[9], h[10];
+  return coal::Transform3s(R, coal::Vec3s(h[3], h[7], h[11]));
+}
+
+}  // namespace
+
+Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placements,
+             const std::vector<double>& axes, const std::vector<bool>& prismatic,
+             const std::vector<int>& states, const std::vector<double>& lower,
+             const std::vector<double>& upper, const std::vector<int>& body_joints,
+             const std::vector<double>& body_placements, const std::vector<double>& semi_axes)
+    : lower_(lower), upper_(upper) {
+  const std::size_t n = parents.size(), dof = lower.size();
+  if (placements.size() != 16 * n || axes.size() != 3 * n || prismatic.size() != n ||
+      states.size() != n)
+    throw std::invalid_argument(
+        "chain: expected 16 placement, 3 axis numbers, a kind and a state index per joint");
+  if (dof == 0 || dof > static_cast<std::size_t>(kMaxJoints) || upper.size() != dof)
+    throw std::invalid_argument("chain: expected 1 to 16 joints with a lower and upper limit each");
+  for (std::size_t j = 0; j < dof; ++j)
+    if (!(lower[j] <= upper[j]) || !std::isfinite(lower[j]) || !std::isfinite(upper[j]))
+      throw std::invalid_argument("chain: expected finite limits with lower <= upper");
+  for (std::size_t i = 0; i < n; ++i) {
+    ChainJoint joint;
+    joint.parent = parents[i];
+    if (joint.parent < 0 || joint.parent > static_cast<int>(i))
+      throw std::invalid_argument("chain: a joint's parent must come before it");
+    joint.placement = transform_of(&placements[16 * i], "chain: joint placement");
+    joint.axis = coal::Vec3s(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]);
+    const double norm = joint.axis.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm))
+      throw std::invalid_argument("chain: expected a non-zero finite joint axis");
+    joint.axis /= norm;
+    joint.prismatic = prismatic[i];
+    joint.state = states[i];
+    if (joint.state < 0 || joint.state >= static_cast<int>(dof))
+      throw std::invalid_argument("chain: a joint's state index is out of range");
+    joints_.push_back(joint);
+  }
+  const std::size_t count = body_joints.size();
+  if (body_placements.size() != 16 * count || semi_axes.size() != 3 * count)
+    throw std::invalid_argument("chain: expected 16 placement numbers and 3 semi-axes per body");
+  for (std::size_t k = 0; k < count; ++k) {
+    ChainBody body;
+    body.joint = body_joints[k];
+    if (body.joint < 0 || body.joint > static_cast<int>(n))
+      throw std::invalid_argument("chain: a body's joint is out of range");
+    body.placement = transform_of(&body_placements[16 * k], "chain: body placement");
+    for (int i = 0; i < 3; ++i) {
+      const double a = semi_axes[3 * k + i];
+      if (!(a > 0.0) || !std::isfinite(a))
+        throw std::invalid_argument("chain: semi-axes must be positive finite numbers");
+      body.semi_axes[i] = a;
+      body.a_max = std::max(body.a_max, a);
+    }
+    bodies_.push_back(body);
+  }
+
+  // the speed bounds (kcplan/arm/bounds.py chain_speeds): how far joint i's origin lies
+  // from its parent's over the whole joint box
+  std::vector<double> hop(n + 1, 0.0);
+  for (std::size_t i = 1; i <= n; ++i) {
+    const ChainJoint& joint = joints_[i - 1];
+    hop[i] = joint.placement.getTranslation().norm();
+    if (joint.prismatic)
+      hop[i] += std::max(std::abs(lower_[joint.state]), std::abs(upper_[joint.state]));
+  }
+  rho_.assign(count * dof, 0.0);
+  carries_.assign(count * dof, false);
+  for (std::size_t k = 0; k < count; ++k) {
+    double reach = bodies_[k].placement.getTranslation().norm() + bodies_[k].a_max;
+    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {  // reach bounds |x - o_i|
+      const ChainJoint& joint = joints_[i - 1];
+      rho_[k * dof + joint.state] = joint.prismatic ? 1.0 : reach;
+      carries_[k * dof + joint.state] = true;
+      reach += hop[i];
+    }
+  }
+}
+
+bool Chain::admits(const double* q) const {
+  for (std::size_t j = 0; j < lower_.size(); ++j)
+    if (!(q[j] >= lower_[j] && q[j] <= upper_[j])) return false;  // NaN fails too
+  return true;
+}
+
+void Chain::joint_frames(const double* q, std::vector<coal::Transform3s>& out) const {
+  out.resize(joints_.size() + 1);
+  out[0].setIdentity();
+  for (std::size_t i = 1; i <= joints_.size(); ++i) {
+    const ChainJoint& joint = joints_[i - 1];
+    const double value = q[joint.state];
+    coal::Transform3s motion;
+    if (joint.prismatic)
+      motion = coal::Transform3s(coal::Matrix3s::Identity(), value * joint.axis);
+    else
+      motion = coal::Transform3s(Eigen::AngleAxisd(value, joint.axis).toRotationMatrix(),
+                                 coal::Vec3s::Zero());
+    out[i] = out[joint.parent] * joint.placement * motion;
+  }
+}
+
+void Chain::body_frames(const double* q, std::vector<coal::Transform3s>& joints,
+                        std::vector<coal::Transform3s>& out) const {
+  joint_frames(q, joints);
+  out.resize(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    out[k] = joints[bodies_[k].joint] * bodies_[k].placement;
+}
+
+std::vector<double> Chain::relative_speeds(const std::vector<std::array<int, 2>>& pairs) const {
+  const std::size_t dof = lower_.size();
+  std::vector<double> out(pairs.size() * dof, 0.0);
+  for (std::size_t m = 0; m < pairs.size(); ++m) {
+    const std::size_t k = pairs[m][0], l = pairs[m][1];
+    if (k >= bodies_.size() || l >= bodies_.size())
+      throw std::invalid_argument("pairs: a body index is out of range");
+    for (std::size_t j = 0; j < dof; ++j) {
+      const bool ck = carries_[k * dof + j], cl = carries_[l * dof + j];
+      // a joint that carries both moves them as one rigid body: no distance changes
+      out[m * dof + j] = (ck && !cl ? rho_[k * dof + j] : 0.0) + (cl && !ck ? rho_[l * dof + j] : 0.0);
+    }
+  }
+  return out;
+}
+
+}  // namespace kcplan

@@ -1,0 +1,92 @@
+// An arm's kinematic chain (the reduced model of its planning group), the ellipsoids that
+// cover its links, and the chain's speed bounds.
+// Python twins: kcplan/arm/kinematics.py (frames) and kcplan/arm/bounds.py (speeds).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include <coal/math/transform.h>
+
+namespace kcplan {
+
+/// One joint of the reduced model: joint i's frame is
+/// oMi[i] = oMi[parent] * placement * motion(q[state]), motion turning by q about `axis`
+/// (revolute) or sliding q along it (prismatic); oMi[0] (the universe) is the identity.
+struct ChainJoint {
+  int parent = 0;
+  coal::Transform3s placement;
+  coal::Vec3s axis{0, 0, 1};  ///< unit, in the joint's frame
+  bool prismatic = false;
+  int state = 0;  ///< which number of the state moves it
+};
+
+/// One covering ellipsoid: semi-axes along its frame's axes, its frame `placement` in
+/// the frame of the joint that carries it (joint 0: fixed to the universe).
+struct ChainBody {
+  int joint = 0;
+  coal::Transform3s placement;
+  std::array<double, 3> semi_axes{0, 0, 0};
+  double a_max = 0.0;
+};
+
+/// The immutable description of an arm: joints, limits and covering bodies, with the
+/// chain's configuration-independent speed bounds (kcplan/arm/bounds.py, Schwarzer, Saha
+/// and Latombe 2005, Sec. III).
+///
+/// Contract: states are the group's joint values (dof() numbers, radians or metres); the
+/// constructor throws std::invalid_argument for an inconsistent description (a parent
+/// after its child, a state index out of range, a zero axis, limits not lower <= upper,
+/// semi-axes not positive). Every method is const: a Chain is shared by worlds and
+/// certifiers.
+class Chain {
+ public:
+  static constexpr int kMaxJoints = 16;
+
+  /// `parents`, `placements` (16 numbers per joint, a row-major homogeneous matrix),
+  /// `axes` (3 per joint), `prismatic` and `states` describe joints 1..n of the reduced
+  /// model (joint 0 is the universe); `lower`, `upper` the limits in state order;
+  /// `body_joints`, `body_placements` (16 per body) and `semi_axes` (3 per body) the
+  /// bodies.
+  Chain(const std::vector<int>& parents, const std::vector<double>& placements,
+        const std::vector<double>& axes, const std::vector<bool>& prismatic,
+        const std::vector<int>& states, const std::vector<double>& lower,
+        const std::vector<double>& upper, const std::vector<int>& body_joints,
+        const std::vector<double>& body_placements, const std::vector<double>& semi_axes);
+
+  int dof() const { return static_cast<int>(lower_.size()); }
+  /// Joints of the reduced model, the universe included.
+  std::size_t joint_count() const { return joints_.size() + 1; }
+  const std::vector<ChainBody>& bodies() const { return bodies_; }
+  const std::vector<double>& lower() const { return lower_; }
+  const std::vector<double>& upper() const { return upper_; }
+
+  /// Whether every number of q (dof() of them) is finite and within its limits.
+  bool admits(const double* q) const;
+  /// World frames of every joint, the universe first (joint_count() of them).
+  void joint_frames(const double* q, std::vector<coal::Transform3s>& out) const;
+  /// World frames of every body (bodies().size() of them); `joints` is scratch.
+  void body_frames(const double* q, std::vector<coal::Transform3s>& joints,
+                   std::vector<coal::Transform3s>& out) const;
+
+  /// rho[k * dof + j]: how far a point of body k moves per unit of joint j's motion, for
+  /// every configuration in the limits (kcplan/arm/bounds.py point_speeds: the farthest
+  /// point from joint j's axis, bounded through the chain's joint origins by the triangle
+  /// inequality; 1 for a prismatic joint; 0 where j does not carry k).
+  const std::vector<double>& point_speeds() const { return rho_; }
+  /// Whether joint j (state order) carries body k: carries()[k * dof + j].
+  const std::vector<bool>& carries() const { return carries_; }
+  /// The bound on how fast the distance between a point of body k and a point of body l
+  /// changes per unit of joint j's motion: only the joints that carry exactly one of
+  /// them count (kcplan/arm/bounds.py relative_speeds). Row m for pairs[m], dof per row.
+  std::vector<double> relative_speeds(const std::vector<std::array<int, 2>>& pairs) const;
+
+ private:
+  std::vector<ChainJoint> joints_;  // joints 1..n; joints_[i - 1] is joint i
+  std::vector<ChainBody> bodies_;
+  std::vector<double> lower_, upper_, rho_;
+  std::vector<bool> carries_;
+};
+
+}  // namespace kcplan

@@ -1,0 +1,207 @@
+"""The compiled twin of arms (kcplan/_kernel: Chain, ArmWorld, ArmCertifier) against its
+Python reference (kcplan.arm.kinematics, kcplan.arm.bounds, kcplan.arm.world,
+kcplan.planning.arm_certifier) and against Pinocchio, with every accepted edge re-checked
+on the links' own meshes."""
+
+from pathlib import Path
+
+import fcl
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.spatial.transform import Rotation
+
+from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm.bounds import carries, point_speeds, relative_speeds
+from kcplan.arm.kinematics import body_frames
+from kcplan.arm.verify import verify_arm_path
+from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
+from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.world import parse_scenario
+from kcplan.world.scenario import Obstacle
+
+ROOT = Path(__file__).resolve().parents[1]
+PANDA = ROOT / "scenarios" / "arm" / "panda"
+GROUP = [f"panda_joint{i}" for i in range(1, 8)]
+
+SCENE = [
+    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},
+    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},
+    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
+]
+CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
+    "cylinder", 3, {}, np.array([0.45, 0.35, 0.4]),
+    Rotation.from_quat([0.3, 0.0, 0.0, 0.954]).as_matrix(), np.array([0.05, 0.05, 0.15]),
+)  # fmt: skip
+
+
+def _obstacles(specs):
+    data = {
+        "name": "scene",
+        "dimension": 3,
+        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
+        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
+        "start": {"position": [0.0, 0.0, 0.0]},
+        "goal": {"position": [0.0, 0.0, 0.0]},
+        "obstacles": specs,
+    }
+    return (*parse_scenario(data, check=False).obstacles, CYLINDER)
+
+
+@pytest.fixture(scope="module")
+def panda(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
+        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=2)
+
+
+@pytest.fixture(scope="module")
+def world(panda):
+    return ArmWorld(panda, _obstacles(SCENE))
+
+
+@pytest.fixture(scope="module")
+def states(panda):
+    return np.random.default_rng(7).uniform(panda.lower, panda.upper, size=(300, panda.dof))
+
+
+def test_kernel_frames_are_pinocchios(panda, world, states):
+    chain = world.kernel.chain
+    data = panda.model.createData()
+    for q in states[:40]:
+        pin.forwardKinematics(panda.model, data, panda.configuration(q))
+        expected = np.array([data.oMi[i].homogeneous for i in range(panda.model.njoints)])
+        frames = np.array(chain.joint_frames(q.tolist())).reshape(-1, 4, 4)
+        np.testing.assert_allclose(frames, expected, rtol=0, atol=1e-12)
+        bodies = np.array(chain.body_frames(q.tolist())).reshape(-1, 4, 4)
+        np.testing.assert_allclose(bodies, body_frames(panda, q), rtol=0, atol=1e-12)
+
+
+def test_kernel_speed_bounds_are_the_python_bounds(panda, world):
+    chain = world.kernel.chain
+    rho = np.array(chain.point_speeds).reshape(len(panda.bodies), panda.dof)
+    np.testing.assert_allclose(rho, point_speeds(panda), rtol=1e-15, atol=0)
+    assert (rho[:2, 0] == 0).all() and (rho[2:, 0] > 0).all()  # link0 (2 bodies) is fixed
+    C = np.array(chain.carries).reshape(rho.shape)
+    assert (C == carries(panda)).all()
+    pairs = world.self_pairs
+    got = np.array(chain.relative_speeds(pairs.tolist())).reshape(len(pairs), panda.dof)
+    np.testing.assert_allclose(got, relative_speeds(rho, C, pairs), rtol=1e-15, atol=0)
+
+
+def test_kernel_and_python_agree_on_every_state(world, states):
+    kernel = world.kernel
+    got = [kernel.in_collision(q.tolist()) for q in states]
+    expected = [world.in_collision(q) for q in states]
+    assert got == expected
+    assert 30 < sum(got) < 270  # both kinds were tried
+
+
+def test_both_clearances_are_lower_bounds_of_the_sampled_distance(panda, world, states):
+    """Each self pair's clearance, kernel (coal) and Python (supports along FCL's
+    direction), is at most the smallest distance between sampled surface points (an
+    upper bound of the distance), and the two differ little."""
+    kernel = world.kernel
+    u = np.random.default_rng(3).normal(size=(4000, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    for q in states[:6]:
+        if world.in_collision(q):
+            continue
+        k_scene, k_pairs = kernel.safe_clearances(q.tolist())
+        p_scene, p_pairs = world.safe_clearances(q)
+        frames = body_frames(panda, q)
+        for m, (i, j) in enumerate(world.self_pairs):
+            a = frames[i][:3, 3] + (u * panda.bodies[i].semi_axes) @ frames[i][:3, :3].T
+            b = frames[j][:3, 3] + (u * panda.bodies[j].semi_axes) @ frames[j][:3, :3].T
+            sampled = np.sqrt(((a[:, None, :] - b[None, ::8, :]) ** 2).sum(-1)).min()
+            assert k_pairs[m] <= sampled and p_pairs[m] <= sampled
+        np.testing.assert_allclose(k_pairs, p_pairs, atol=0.02)
+        np.testing.assert_allclose(k_scene, p_scene, atol=0.02)
+
+
+# two of the Panda's covering ellipsoids (K = 4) at a state of box_1: frames and semi-axes
+FRAME_A = [
+    [-0.258527440075, -0.782940024823, 0.56583432227, -0.231000054592],
+    [-0.790483528887, 0.508143301405, 0.341944696983, 0.005782809322],
+    [-0.555247110111, -0.358880624676, -0.750270180632, 0.29465356976],
+]
+FRAME_B = [
+    [-0.469978999907, 0.527399294467, -0.707792147344, -0.409912721165],
+    [-0.818900442519, 0.038745536239, 0.572626273116, 0.015912278893],
+    [0.329426478729, 0.848733625832, 0.413677927251, 0.21608404707],
+]
+AXES_A = [0.037072799508, 0.065385681018, 0.082023441791]
+AXES_B = [0.007962846033, 0.016329866169, 0.028091109846]
+
+
+def test_fcl_overestimates_thin_ellipsoids_and_the_arm_world_does_not():
+    """The case that made the Python world take only FCL's direction: FCL's distance
+    exceeds the sampled distance (an upper bound of the true one) by 7 %, and
+    :func:`kcplan.world.support.separation` along FCL's direction stays below it."""
+    from kcplan.world.support import EllipsoidSupport, separation
+
+    Fa, Fb = np.array(FRAME_A), np.array(FRAME_B)
+    Ra, Rb = Fa[:, :3], Fb[:, :3]
+    a, b = np.array(AXES_A), np.array(AXES_B)
+    o1 = fcl.CollisionObject(fcl.Ellipsoid(*a), fcl.Transform(Ra, Fa[:, 3]))
+    o2 = fcl.CollisionObject(fcl.Ellipsoid(*b), fcl.Transform(Rb, Fb[:, 3]))
+    result = fcl.DistanceResult()
+    d = fcl.distance(o1, o2, fcl.DistanceRequest(enable_nearest_points=True), result)
+    u = np.random.default_rng(0).normal(size=(20000, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    pa, pb = Fa[:, 3] + (u * a) @ Ra.T, Fb[:, 3] + (u[::5] * b) @ Rb.T
+    sampled = min(np.sqrt(((pa[i : i + 2000, None] - pb[None]) ** 2).sum(-1)).min()
+                  for i in range(0, len(pa), 2000))  # fmt: skip
+    assert d > 1.05 * sampled  # FCL: 0.1256 m; the distance is at most 0.1168 m
+    n = result.nearest_points[1] - result.nearest_points[0]
+    n /= np.linalg.norm(n)
+    gap = separation(EllipsoidSupport(Fa[:, 3], Ra, a), EllipsoidSupport(Fb[:, 3], Rb, b), n)
+    assert 0.9 * sampled < gap <= sampled
+
+
+def test_kernel_certifier_decides_as_the_python_certifier(panda, world, states):
+    free = [q for q in states if not world.in_collision(q)][:40]
+    kernel, python = KernelArmCertifier(world), ArmEdgeCertifier(world)
+    same = 0
+    for q1, q2 in zip(free, free[1:], strict=False):
+        q2 = q1 + 0.25 * (q2 - q1)
+        same += kernel.check(q1, q2) == python.check(q1, q2)
+    assert same >= len(free) - 2
+    k, p = kernel.counters, python.counters
+    assert k["edges"] == p["edges"] == len(free) - 1
+    for name in ARM_COUNTER_NAMES:  # coal's and FCL's distances differ a little
+        assert abs(k[name] - p[name]) <= max(3, 0.05 * p[name]), name
+    assert k["certified_by_endpoints"] + k["certified_one_guard"] < k["edges"] - k["rejected"]
+
+
+def test_every_edge_the_kernel_accepts_is_free_on_the_meshes(panda, world, states):
+    free = [q for q in states if not world.in_collision(q)]
+    kernel = KernelArmCertifier(world)
+    rng = np.random.default_rng(5)
+    accepted = 0
+    for _ in range(60):
+        q1, q2 = free[rng.integers(len(free))], free[rng.integers(len(free))]
+        q2 = q1 + rng.uniform(0.05, 0.6) * (q2 - q1)
+        if kernel.check(q1, q2):
+            accepted += 1
+            check = verify_arm_path(panda, world.obstacles, [q1, q2])
+            assert not check.collides, (q1, q2, check)
+    assert accepted >= 15
+
+
+def test_the_kernel_never_certifies_a_bad_state(panda, world, states):
+    kernel = KernelArmCertifier(world)
+    q = next(q for q in states if not world.in_collision(q))
+    assert kernel.state_valid(q)
+    before = world.counters["collision_queries"]
+    for bad in (np.nan, np.inf, -np.inf, 1e308, panda.upper[0] + 1e-9):
+        r = q.copy()
+        r[0] = bad
+        assert not kernel.state_valid(r)
+        assert not kernel.check(q, r)
+        assert not kernel.check(r, q)
+    assert world.counters["collision_queries"] == before  # rejected with no query
+    with pytest.raises(ValueError, match="expected 7 joint values, got 6"):
+        kernel.check(q, q[:6])
+    with pytest.raises(ValueError, match="finite joint values"):
+        world.kernel.in_collision([np.nan] * panda.dof)
