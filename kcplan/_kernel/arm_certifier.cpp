@@ -22,6 +22,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   speed_.resize(chain_.bodies().size());
   pair_speed_.resize(world.pairs().size());
   q_.resize(n_);
+  caps_.resize(speed_.size());
 }
 
 bool ArmCertifier::reject(std::int64_t& reason) {
@@ -42,23 +43,29 @@ bool ArmCertifier::state_valid(const double* q) {
   return known == 1;
 }
 
-ArmGuard ArmCertifier::measure(const double* q) {
+ArmGuard ArmCertifier::measure(const double* q, const double* caps) {
   ++counters.guards;
   ArmGuard g;
   std::copy(q, q + n_, g.q.begin());
   const std::size_t bodies = chain_.bodies().size(), pairs = world_.pairs().size();
   g.scene.resize(bodies);
   g.pairs.resize(pairs);
-  g.exact.assign(pairs, 0);
+  g.scene_exact.assign(bodies, caps == nullptr);
+  g.pair_exact.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
-  world_.scene_clearances(g.scene.data());
+  if (caps != nullptr) {
+    for (std::size_t k = 0; k < bodies; ++k) caps_[k] = std::max(caps[k], kClearanceFloor);
+    world_.scene_clearances(g.scene.data(), caps_.data());
+  } else {
+    world_.scene_clearances(g.scene.data());
+  }
   g.clearance = std::numeric_limits<double>::infinity();
   for (double d : g.scene) g.clearance = std::min(g.clearance, d);
   for (std::size_t m = 0; m < pairs; ++m) {
     g.pairs[m] = world_.pair_gap(m, frames);
     if (g.pairs[m] <= 0.0) {  // the balls meet: only GJK can tell whether the bodies do
       g.pairs[m] = world_.pair_clearance(m, frames);
-      g.exact[m] = 1;
+      g.pair_exact[m] = 1;
     }
     g.clearance = std::min(g.clearance, g.pairs[m]);
   }
@@ -66,19 +73,35 @@ ArmGuard ArmCertifier::measure(const double* q) {
 }
 
 double ArmCertifier::radius(const ArmGuard& guard, const std::vector<double>& speed,
-                            const std::vector<double>& pair_speed) {
+                            const std::vector<double>& pair_speed, double enough) {
   if (guard.clearance <= 0.0) return 0.0;
   double r = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < speed.size(); ++k)
-    if (speed[k] > 0.0) r = std::min(r, guard.scene[k] / speed[k]);
+    if (speed[k] > 0.0 && guard.scene_exact[k]) r = std::min(r, guard.scene[k] / speed[k]);
   bool placed = false;
+  const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
+    if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
+    return frames_;
+  };
+  // a bound that would hold r below what is needed is refined first: the radius is then
+  // that of exact distances, or at least `enough`
+  for (std::size_t k = 0; k < speed.size(); ++k) {
+    const double v = speed[k];
+    if (!(v > 0.0) || guard.scene_exact[k]) continue;
+    if (guard.scene[k] < std::min(r, enough) * v) {
+      const double cap = std::numeric_limits<double>::infinity();
+      guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
+      guard.scene_exact[k] = 1;
+      ++refined_bodies;
+    }
+    r = std::min(r, guard.scene[k] / v);
+  }
   for (std::size_t m = 0; m < pair_speed.size(); ++m) {
     const double v = pair_speed[m];
-    if (!(v > 0.0) || guard.pairs[m] >= r * v) continue;
-    if (!guard.exact[m]) {  // the balls' gap limits r: ask for the distance itself
-      if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
-      guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames_));
-      guard.exact[m] = 1;
+    if (!(v > 0.0)) continue;
+    if (!guard.pair_exact[m] && guard.pairs[m] < std::min(r, enough) * v) {
+      guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
+      guard.pair_exact[m] = 1;
       ++refined_pairs;
     }
     r = std::min(r, guard.pairs[m] / v);
@@ -93,7 +116,9 @@ std::shared_ptr<const ArmGuard> ArmCertifier::endpoint(const double* q,
     return g;
   }
   ++counters.endpoint_guards;
-  return cache_.add_guard(key, measure(q));
+  // as much as this edge needs: its whole length (s in [0, 1]) from this end
+  for (std::size_t k = 0; k < speed_.size(); ++k) caps_[k] = kCapSlack * speed_[k];
+  return cache_.add_guard(key, measure(q, caps_.data()));
 }
 
 bool ArmCertifier::check(const double* q1, const double* q2) {
@@ -113,10 +138,11 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * q_[j];
     pair_speed_[m] = v;
   }
-  const double lo = radius(*endpoint(q1, ArmGuardCache::key_of(q1, n_)), speed_, pair_speed_);
+  const double lo =
+      radius(*endpoint(q1, ArmGuardCache::key_of(q1, n_)), speed_, pair_speed_, 1.0);
   if (lo <= 0.0) return reject(c.rejected_guard);
-  const double hi =
-      1.0 - radius(*endpoint(q2, ArmGuardCache::key_of(q2, n_)), speed_, pair_speed_);
+  const double hi = 1.0 - radius(*endpoint(q2, ArmGuardCache::key_of(q2, n_)), speed_,
+                                 pair_speed_, 1.0 - lo);
   if (hi >= 1.0) return reject(c.rejected_end_state);
   if (lo >= hi) {
     ++c.certified_by_endpoints;
@@ -127,9 +153,12 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
   int guards = 0;
   const Advanced outcome = advance(
       lo, hi, max_guards_, pending_,
-      [&](double m, double, double, double& g_lo, double& g_hi) {
+      [&](double m, double s0, double s1, double& g_lo, double& g_hi) {
         for (int j = 0; j < n_; ++j) q[j] = q1[j] + m * (q2[j] - q1[j]);
-        const double r = radius(measure(q.data()), speed_, pair_speed_);
+        const double enough = 0.5 * (s1 - s0);  // this guard covers [s0, s1] with that
+        std::vector<double>& caps = caps_;
+        for (std::size_t k = 0; k < speed_.size(); ++k) caps[k] = kCapSlack * enough * speed_[k];
+        const double r = radius(measure(q.data(), caps.data()), speed_, pair_speed_, enough);
         if (r <= 0.0) return false;
         g_lo = m - r, g_hi = m + r;
         return true;

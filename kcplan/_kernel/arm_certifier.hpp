@@ -17,15 +17,16 @@ namespace kcplan {
 
 /// One guard of an arm: what one distance query at the state q proves.
 ///
-/// `scene[k]` is body k's certain clearance to the obstacles; `pairs[m]` a certain lower
-/// bound of self pair m's distance, first the bounding balls' gap (ArmWorld::pair_gap),
-/// raised to the pair's GJK distance the first time a certificate needs more (`exact`).
-/// Raising a lower bound never makes it wrong, so a cached guard may be refined in place.
+/// `scene[k]` is a certain lower bound of body k's clearance to the obstacles: its
+/// clearance, or (when `scene_exact[k]` is 0) a cap below it, as much as the edge it was
+/// measured for needed; `pairs[m]` a certain lower bound of self pair m's distance, first
+/// the bounding balls' gap (ArmWorld::pair_gap), raised to the pair's GJK distance the
+/// first time a certificate needs more (`pair_exact`). Raising a lower bound never makes
+/// it wrong, so a cached guard is refined in place when another edge needs more of it.
 struct ArmGuard {
   std::array<double, Chain::kMaxJoints> q{};
-  std::vector<double> scene;
-  mutable std::vector<double> pairs;
-  mutable std::vector<char> exact;
+  mutable std::vector<double> scene, pairs;
+  mutable std::vector<char> scene_exact, pair_exact;
   double clearance = 0.0;  ///< > 0: the state is free (the smallest bound, once exact)
 };
 
@@ -65,19 +66,29 @@ class ArmCertifier {
   bool check(const double* q1, const double* q2);
   /// State validity with the cache: one collision query for a state not seen before.
   bool state_valid(const double* q);
-  /// One guard at q, not cached.
-  ArmGuard measure(const double* q);
-  /// The half width, in s, of the stretch `guard` proves free for the speeds (refines
-  /// the guard's pair bounds where they limit it).
+  /// One guard at q, not cached; body k's clearance is measured up to caps[k] (null:
+  /// wholly), and never below kClearanceFloor, so that clearance > 0 still means free.
+  ArmGuard measure(const double* q, const double* caps = nullptr);
+  /// The half width, in s, of a stretch `guard` proves free for the speeds: the
+  /// clearance ball's radius min(d_k / v_k, d_kl / v_kl), or a radius of at least
+  /// `enough` (the guard's bounds are refined where they would limit it below that).
   double radius(const ArmGuard& guard, const std::vector<double>& speed,
-                const std::vector<double>& pair_speed);
+                const std::vector<double>& pair_speed, double enough);
+
+  /// The smallest cap of a body's clearance (metres): a body closer than this to an
+  /// obstacle is always measured.
+  static constexpr double kClearanceFloor = 1e-6;
+  /// Caps are this much above what a stretch needs, so that the radius they give, less
+  /// its rounding margin, still covers the stretch.
+  static constexpr double kCapSlack = 1.0 + 1e-6;
 
   ArmWorld& world() { return world_; }
   const ArmGuardCache& cache() const { return cache_; }
   int max_guards() const { return max_guards_; }
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
   CertifierCounters counters;
-  std::int64_t refined_pairs = 0;  ///< pair bounds raised to their GJK distance
+  std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
+  std::int64_t refined_bodies = 0;  ///< capped scene clearances measured again, uncapped
 
  private:
   std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);
@@ -88,7 +99,7 @@ class ArmCertifier {
   int n_, max_guards_;
   ArmGuardCache cache_;
   std::vector<double> rho_, rho_pairs_;
-  std::vector<double> speed_, pair_speed_, q_;
+  std::vector<double> speed_, pair_speed_, q_, caps_;
   std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
   std::vector<std::pair<double, double>> pending_;
 };

@@ -49,8 +49,15 @@ class ArmWorld {
   /// Place the bodies at q (no query) and return their frames; valid until the next
   /// place().
   const std::vector<coal::Transform3s>& place(const double* q);
-  /// Certain clearance of each body to the obstacles, as placed (one distance query).
-  void scene_clearances(double* out) { scene_->bodies_safe_clearances(out); }
+  /// Certain clearance of each body to the obstacles, as placed (one distance query);
+  /// with `caps`, min(clearance, caps[k]) (World::bodies_safe_clearances).
+  void scene_clearances(double* out, const double* caps = nullptr) {
+    scene_->bodies_safe_clearances(out, caps);
+  }
+  /// min(cap, body k's certain clearance to the obstacles) with the bodies at `frames`.
+  double body_clearance(std::size_t k, const std::vector<coal::Transform3s>& frames, double cap) {
+    return scene_->body_safe_clearance(k, frames[k], cap);
+  }
   /// A certain lower bound of self pair m's distance with the bodies at `frames`: the
   /// gap between their bounding balls, less rounding (<= 0: nothing known).
   double pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;

@@ -341,6 +341,7 @@ NB_MODULE(_core, m) {
       .def_prop_ro("counters", [](const kcplan::ArmCertifier& c) {
         nb::dict d = certifier_counters(c.counters);
         d["refined_pairs"] = c.refined_pairs;
+        d["refined_bodies"] = c.refined_bodies;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {

@@ -128,17 +128,22 @@ struct World::CollideNear : coal::CollisionCallBackBase {
 /// The smallest distance of one query shape to the broad phase's candidates, which the
 /// broad phase uses to prune; stops at contact.
 struct World::DistanceNear : coal::DistanceCallBackBase {
-  DistanceNear(World* w, coal::CollisionObject* q, std::size_t s) : world(w), query(q), shape(s) {}
+  DistanceNear(World* w, coal::CollisionObject* q, std::size_t s,
+               double cap = std::numeric_limits<double>::infinity())
+      : world(w), query(q), shape(s), best(cap) {}
   World* world;
   coal::CollisionObject* query;
   std::size_t shape;
-  double best = std::numeric_limits<double>::infinity();
+  double best;  // starts at the cap: the broad phase then prunes every box beyond it
   coal::DistanceRequest request = distance_request(false);
   coal::DistanceResult result;
   bool distance(coal::CollisionObject* o1, coal::CollisionObject* o2,
                 coal::CoalScalar& dist) override {
     coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
-    best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
+    // the boxes' distance bounds the shapes' (each box holds its shape): past the cap,
+    // or past the best so far, the obstacle cannot lower the answer
+    if (query->getAABB().distance(obstacle->getAABB()) < best)
+      best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
     dist = best;
     return best <= 0.0;
   }
@@ -453,9 +458,33 @@ void World::safe_body_clearances(const Pose& pose, double* out) {
   bodies_safe_clearances(out);
 }
 
-void World::bodies_safe_clearances(double* out) {
-  bodies_distances(out);
-  for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = safe(out[k]);
+void World::bodies_safe_clearances(double* out, const double* caps) {
+  if (caps == nullptr) {
+    bodies_distances(out);
+    for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = safe(out[k]);
+    return;
+  }
+  ++counters.distance_queries;
+  for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = capped_clearance(k, caps[k]);
+}
+
+double World::body_safe_clearance(std::size_t k, const coal::Transform3s& frame, double cap) {
+  bodies_[k]->setTransform(frame);
+  bodies_[k]->computeAABB();
+  ++counters.distance_queries;
+  return capped_clearance(k, cap);
+}
+
+double World::capped_clearance(std::size_t k, double cap) {
+  if (objects_.empty()) return std::numeric_limits<double>::infinity();
+  count_body(k);
+  // a raw distance of at least (cap + atol) / (1 - rtol) is certainly at least cap
+  const double raw = cap < std::numeric_limits<double>::infinity()
+                         ? (cap + atol_) / (1.0 - rtol_)
+                         : std::numeric_limits<double>::infinity();
+  DistanceNear near(this, bodies_[k].get(), k, raw);
+  manager_->distance(bodies_[k].get(), &near);
+  return near.best >= raw ? cap : safe(near.best);
 }
 
 bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out) {

@@ -125,8 +125,13 @@ class World {
   bool bodies_collide();
   /// body_distances for the bodies as placed.
   void bodies_distances(double* out);
-  /// safe_body_clearances for the bodies as placed.
-  void bodies_safe_clearances(double* out);
+  /// safe_body_clearances for the bodies as placed. With `caps` (one per body), body k
+  /// gets min(its clearance, caps[k]) (still never an overestimate), and obstacles whose
+  /// bounding box lies farther than the cap are not measured at all.
+  void bodies_safe_clearances(double* out, const double* caps = nullptr);
+  /// min(cap, the certain clearance) of body k placed at `frame` (one distance query; the
+  /// other bodies stay where they are).
+  double body_safe_clearance(std::size_t k, const coal::Transform3s& frame, double cap);
   /// A distance reduced by the error allowance, d (1 - rtol) - atol, at least 0: what a
   /// coal distance certainly is (never an overestimate).
   double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
@@ -194,6 +199,7 @@ class World {
                                                bool measure) const;
   std::size_t core_shape() const { return bodies_.size(); }
   void count_body(std::size_t k);
+  double capped_clearance(std::size_t k, double cap);
 
   Robot robot_;
   int dimension_;
