@@ -6,23 +6,30 @@ twice: for the arm covered by ``--bodies`` ellipsoids per link
 (:class:`kcplan.arm.ArmWorld`, what a certifier plans with) and for the links' own
 collision meshes (:func:`kcplan.arm.verify.verify_arm_path` at the one state), both with
 the scene's allowed collision matrix. A state valid on the meshes but not for the cover
-is one the cover makes unreachable. Prints a Markdown table, and with ``--offsets`` a
-second one: how far each link's cover sticks out of its mesh
-(:func:`kcplan.cover.offset.cover_offsets`)::
+is one the cover makes unreachable. Covers: ``--bodies K,...`` (exactly K per link, the
+smallest union) and ``--max-offset D,...`` (metres: as many per link as it takes to
+stick out by at most D, :func:`kcplan.arm.load_arm`; ``default`` is
+:data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`). Prints a Markdown table, one line per cover
+(bodies, self pairs, time to load), and with ``--offsets`` how far each link's cover
+sticks out of its mesh (mm: the fit's proved bound for ``--max-offset`` covers, the
+sampled estimate :func:`kcplan.cover.offset.cover_offsets` for ``--bodies`` ones) and
+how many bodies it has::
 
-    python scripts/mbm_validity.py [--per-class 100] [--bodies 1,2] [--offsets]
+    python scripts/mbm_validity.py [--per-class 100] [--bodies 1,2] [--max-offset default]
+        [--offsets]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import time
 from pathlib import Path
 
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
-from kcplan.arm.model import mesh_cover
+from kcplan.arm.model import DEFAULT_MAX_OFFSET, mesh_cover
 from kcplan.arm.verify import verify_arm_path
 from kcplan.cover.offset import cover_offsets
 
@@ -37,7 +44,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--urdf", default=os.fspath(PANDA / "panda.urdf"))
     parser.add_argument("--srdf", default=os.fspath(PANDA / "panda.srdf"))
     parser.add_argument("--per-class", type=int, default=100)
-    parser.add_argument("--bodies", default="1", help="bodies per link, comma-separated")
+    parser.add_argument("--bodies", default="", help="bodies per link, comma-separated")
+    parser.add_argument("--max-offset", default="", help="metres (or 'default'), comma-separated")
     parser.add_argument("--offsets", action="store_true", help="also how far covers stick out")
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
@@ -47,11 +55,23 @@ def main(argv: list[str] | None = None) -> int:
     if len(groups) != 1:
         parser.error(f"archive: expected one planning group, got {sorted(groups)}")
     (joints,) = groups
-    print("| bodies per link | class | problems | starts valid: cover / meshes | "
+    covers = [(b, None) for b in (int(k) for k in args.bodies.split(",") if k)]
+    for text in (t for t in args.max_offset.split(",") if t):
+        covers.append((None, DEFAULT_MAX_OFFSET if text == "default" else float(text)))
+    if not covers:
+        parser.error("expected --bodies or --max-offset")
+    print("| cover | class | problems | starts valid: cover / meshes | "
           "goals valid: cover / meshes | lost to the cover |")  # fmt: skip
     print("|---|---|---|---|---|---|")
-    for bodies in (int(b) for b in args.bodies.split(",")):
-        arm = load_arm(args.urdf, joints, srdf=args.srdf, bodies_per_link=bodies)
+    arms, notes = [], []
+    for bodies, max_offset in covers:
+        t0 = time.perf_counter()
+        arm = load_arm(args.urdf, joints, srdf=args.srdf, bodies_per_link=bodies,
+                       max_offset=max_offset)  # fmt: skip
+        label = f"{bodies}" if max_offset is None else f"<= {1000 * max_offset:g} mm"
+        arms.append((label, bodies, max_offset, arm))
+        notes.append(f"{label}: {len(arm.bodies)} bodies, {len(arm.self_pairs)} self pairs, "
+                     f"loaded in {time.perf_counter() - t0:.1f} s")  # fmt: skip
         totals = [0, 0, 0, 0, 0, 0]
         for problem_class in MBM_CLASSES:
             chosen = [problems[problem_class, i] for i in range(1, args.per_class + 1)
@@ -69,26 +89,39 @@ def main(argv: list[str] | None = None) -> int:
                     counts[4] += meshes and not cover
             row = [len(chosen), *counts]
             totals = [a + b for a, b in zip(totals, row, strict=True)]
-            print(f"| {bodies} | {problem_class} | {row[0]} | {row[1]} / {row[2]} | "
+            print(f"| {label} | {problem_class} | {row[0]} | {row[1]} / {row[2]} | "
                   f"{row[3]} / {row[4]} | {row[5]} |")  # fmt: skip
-        print(f"| {bodies} | all | {totals[0]} | {totals[1]} / {totals[2]} | "
+        print(f"| {label} | all | {totals[0]} | {totals[1]} / {totals[2]} | "
               f"{totals[3]} / {totals[4]} | {totals[5]} |")  # fmt: skip
+    print()
+    for line in notes:
+        print(f"- {line}")
     if args.offsets:
-        print_offsets(arm, [int(b) for b in args.bodies.split(",")])
+        print_offsets(arms)
     return 0
 
 
-def print_offsets(arm, counts: list[int]) -> None:
-    """How far each link's cover sticks out of its mesh, in mm, per bodies per link."""
-    print(f"\n| link | {' | '.join(f'{k} bodies: offset mm' for k in counts)} |")
-    print(f"|---|{'---|' * len(counts)}")
-    for obj in arm.geometry.geometryObjects:
+def print_offsets(arms: list) -> None:
+    """How far each link's cover sticks out of its mesh, in mm: the sampled estimate for a
+    cover of K bodies per link, the fit's proved bound and the number of bodies for a
+    ``--max-offset`` cover."""
+    heads = [
+        f"{label} bodies: offset mm (sampled)" if max_offset is None
+        else f"{label}: offset mm, proved (bodies)"
+        for label, _, max_offset, _ in arms
+    ]  # fmt: skip
+    print(f"\n| link | {' | '.join(heads)} |")
+    print(f"|---|{'---|' * len(arms)}")
+    for obj in arms[0][3].geometry.geometryObjects:
         if not obj.meshPath:
             continue
         cells = []
-        for k in counts:
-            cover, _ = mesh_cover(obj.meshPath, k, float(obj.meshScale[0]))
-            cells.append(f"{1000 * cover_offsets(cover.solid, cover.bodies).max():.0f}")
+        for _, bodies, max_offset, _ in arms:
+            cover, _ = mesh_cover(obj.meshPath, bodies, float(obj.meshScale[0]), max_offset)
+            if max_offset is None or math.isnan(cover.offset):
+                cells.append(f"{1000 * cover_offsets(cover.solid, cover.bodies).max():.0f}")
+            else:
+                cells.append(f"{1000 * cover.offset:.1f} ({len(cover.bodies)})")
         print(f"| {obj.name} | {' | '.join(cells)} |")
 
 

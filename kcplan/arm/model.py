@@ -43,8 +43,21 @@ from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
 from kcplan.geometry.pose import quaternion_matrix
+from kcplan.geometry.robot import MAX_BODIES
 
-__all__ = ["ArmBody", "ArmError", "ArmModel", "JOINT_KINDS", "load_arm", "mesh_cover"]
+__all__ = [
+    "DEFAULT_MAX_OFFSET",
+    "JOINT_KINDS",
+    "ArmBody",
+    "ArmError",
+    "ArmModel",
+    "load_arm",
+    "mesh_cover",
+]
+
+DEFAULT_MAX_OFFSET = 0.01
+"""How far, in metres, a link's cover may stick out of its mesh when nothing else is
+asked (:func:`load_arm`); see its docstring for why."""
 
 JOINT_KINDS = {
     "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
@@ -168,9 +181,10 @@ def load_arm(
     joints: Sequence[str],
     srdf: str | os.PathLike | None = None,
     fixed: Mapping[str, float] | None = None,
-    bodies_per_link: int = 4,
+    bodies_per_link: int | None = None,
     package_dirs: Sequence[str | os.PathLike] | None = None,
     progress: Callable[[str], None] | None = None,
+    max_offset: float | None = None,
 ) -> ArmModel:
     """Read an arm from its URDF (and SRDF) and cover its links by ellipsoids.
 
@@ -187,15 +201,18 @@ def load_arm(
     fixed : mapping of str to float, optional
         Values of joints outside the group (default 0, or the nearest limit when 0 lies
         outside them).
-    bodies_per_link : int
-        Ellipsoids per mesh geometry (:func:`kcplan.cover.cache.cached_cover`). On MBM's
-        Panda, 4 leave 60 of 70 goals valid, 1 leaves 1 and 8 leave 28 (the fit minimises
-        volume, not how far a body sticks out; ``scripts/mbm_validity.py``);
-        fitting the Panda's ten meshes takes about 40 s once, then they are cached.
+    bodies_per_link : int, optional
+        Alone: exactly this many ellipsoids per mesh geometry, the fit minimising their
+        union's volume (:func:`kcplan.cover.cache.cached_cover`). With ``max_offset``:
+        the most per mesh (default :data:`kcplan.cover.fit.MAX_OFFSET_BODIES`).
     package_dirs : sequence of path-like, optional
     progress : callable, optional
-        Called with one line per mesh covered (fitted or from the cache, and how long it
-        took).
+        Called with one line per mesh covered (fitted or from the cache, how long it
+        took, how far it sticks out, and the fit's note when it hit the most bodies).
+    max_offset : float, optional
+        Cut each mesh's cover until no body sticks out of the mesh by more than this, in
+        metres (a proved bound, :mod:`kcplan.cover.offset`). When neither this nor
+        ``bodies_per_link`` is given: :data:`DEFAULT_MAX_OFFSET`.
 
     Raises
     ------
@@ -205,6 +222,16 @@ def load_arm(
     import pinocchio as pin  # imported here: the rigid planners never need it
 
     source = os.fspath(urdf)
+    if bodies_per_link is None and max_offset is None:
+        max_offset = DEFAULT_MAX_OFFSET
+    if bodies_per_link is not None and not (
+        isinstance(bodies_per_link, int) and 1 <= bodies_per_link <= MAX_BODIES
+    ):
+        raise ArmError(
+            f"{source}: bodies_per_link: expected 1 to {MAX_BODIES}, got {bodies_per_link!r}"
+        )
+    if max_offset is not None and not (math.isfinite(max_offset) and max_offset > 0):
+        raise ArmError(f"{source}: max_offset: expected a positive number, got {max_offset!r}")
     if not Path(source).is_file():
         raise ArmError(f"{source}: urdf: expected a URDF file, found none")
     dirs = [os.fspath(d) for d in (package_dirs or [Path(source).parent])]
@@ -257,7 +284,7 @@ def load_arm(
     for index, obj in enumerate(geometry.geometryObjects):
         placement = np.asarray(obj.placement.homogeneous, dtype=float)
         link = model.frames[obj.parentFrame].name
-        for frame, semi_axes in _cover(obj, bodies_per_link, source, progress):
+        for frame, semi_axes in _cover(obj, bodies_per_link, max_offset, source, progress):
             bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
     self_pairs = _self_pairs(geometry, bodies)
     return ArmModel(
@@ -287,7 +314,11 @@ def _group(full, joints: Sequence[str], source: str) -> list[str]:
 
 
 def _cover(
-    obj, bodies: int, source: str, progress: Callable[[str], None] | None = None
+    obj,
+    bodies: int | None,
+    max_offset: float | None,
+    source: str,
+    progress: Callable[[str], None] | None = None,
 ) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
     """``(frame, semi_axes)`` of the ellipsoids covering one geometry, frames ``(4, 4)`` in
     the geometry's frame (see the module docstring for the primitives)."""
@@ -312,15 +343,16 @@ def _cover(
         )
     start = time.perf_counter()
     try:
-        cover, origin = mesh_cover(obj.meshPath, bodies, float(scale[0]))
+        cover, origin = mesh_cover(obj.meshPath, bodies, float(scale[0]), max_offset)
     except SolidError as err:
         raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
     if progress is not None:
-        progress(
-            f"{obj.name}: {len(cover.bodies)} bod{'y' if len(cover.bodies) == 1 else 'ies'}, "
-            f"{origin} in "
-            f"{time.perf_counter() - start:.1f} s"
-        )
+        count = len(cover.bodies)
+        line = f"{obj.name}: {count} bod{'y' if count == 1 else 'ies'}, {origin} in "
+        line += f"{time.perf_counter() - start:.1f} s"
+        if not math.isnan(cover.offset):
+            line += f", sticking out by at most {1000 * cover.offset:.1f} mm"
+        progress(line + (f" ({cover.note})" if cover.note else ""))
     out = []
     for body in cover.bodies:
         frame = np.eye(4)
@@ -330,10 +362,17 @@ def _cover(
     return out
 
 
-def mesh_cover(path: str | os.PathLike, bodies: int, scale: float = 1.0) -> tuple[Cover, str]:
-    """The cover of a link's collision mesh (:func:`kcplan.cover.cache.cached_cover`), or
-    of its convex hull when the mesh is not closed (a surface: its hull holds every
-    triangle); ``origin`` says which and whether it came from the cache.
+def mesh_cover(
+    path: str | os.PathLike,
+    bodies: int | None,
+    scale: float = 1.0,
+    max_offset: float | None = None,
+) -> tuple[Cover, str]:
+    """The cover of a link's collision mesh (:func:`kcplan.cover.cache.cached_cover`: by
+    ``bodies`` ellipsoids, or with ``max_offset`` by at most ``bodies`` that stick out of
+    the mesh by at most ``max_offset``), or of its convex hull when the mesh is not closed
+    (a surface: its hull holds every triangle; the offset is then from the hull);
+    ``origin`` says which and whether it came from the cache.
 
     Raises
     ------
@@ -341,10 +380,12 @@ def mesh_cover(path: str | os.PathLike, bodies: int, scale: float = 1.0) -> tupl
         When neither the mesh nor its hull can be covered.
     """
     try:
-        return cached_cover(path, bodies, scale=scale)
+        return cached_cover(path, bodies, scale=scale, max_offset=max_offset)
     except SolidError as err:
         try:
-            cover, origin = cached_cover(path, bodies, scale=scale, hull=True)
+            cover, origin = cached_cover(
+                path, bodies, scale=scale, hull=True, max_offset=max_offset
+            )
         except SolidError:
             raise err from None
         return cover, f"{origin} (its convex hull: the mesh is not closed)"

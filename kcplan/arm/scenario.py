@@ -5,7 +5,7 @@ The format (``scenarios/README.md``)::
     name: box_1
     robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,
             joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
-            bodies_per_link: 4, inflation: 0.0}
+            bodies_per_link: K, max_offset: E, inflation: 0.0}
     start: {joints: [...]}            # the group's values, in ``joints`` order
     goal: {joints: [...]}
     obstacles: [{box: {center, size, quaternion}}, {cylinder: {center, quaternion,
@@ -14,7 +14,11 @@ The format (``scenarios/README.md``)::
     allowed: [[LINK, LINK], ...]      # link pairs allowed to touch (MoveIt's ACM)
 
 Paths are relative to the scenario file. ``joints`` is the planning group in state
-order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`). A
+order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`).
+``max_offset`` (metres) cuts each link's cover until it sticks out of the link's mesh by
+at most that much, with ``bodies_per_link`` as the most bodies per link; ``bodies_per_link``
+alone fits exactly that many (the smallest union); neither gives
+:data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`. A
 cylinder's axis is its local z. ``inflation`` is kept for the KC certificate of arms
 (to come); the clearance-ball certificate does not use it. Every field is validated with
 the rigid format's one-line errors (:class:`kcplan.world.scenario.ScenarioError`).
@@ -117,7 +121,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
     spec = r.mapping(
         top["robot"], "robot", ("urdf", "joints"),
-        ("srdf", "fixed", "bodies_per_link", "inflation"),
+        ("srdf", "fixed", "bodies_per_link", "max_offset", "inflation"),
     )  # fmt: skip
     urdf = directory / r.text(spec["urdf"], "robot.urdf")
     srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
@@ -132,16 +136,22 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     if not isinstance(fixed, dict):
         r.fail("robot.fixed", "a mapping of joint names to values", fixed)
     fixed = {str(k): r.number(v, f"robot.fixed.{k}") for k, v in fixed.items()}
-    bodies = spec.get("bodies_per_link", 4)
-    if isinstance(bodies, bool) or not isinstance(bodies, int) or not 1 <= bodies <= 32:
+    bodies = spec.get("bodies_per_link")
+    if bodies is not None and (
+        isinstance(bodies, bool) or not isinstance(bodies, int) or not 1 <= bodies <= 32
+    ):
         r.fail("robot.bodies_per_link", "an integer from 1 to 32", bodies)
+    max_offset = None
+    if "max_offset" in spec:
+        max_offset = r.number(spec["max_offset"], "robot.max_offset", positive=True)
     inflation = r.number(spec.get("inflation", 0.0), "robot.inflation")
     if inflation < 0:
         r.fail("robot.inflation", "a number >= 0", inflation)
     try:
         arm = load_arm(
-            urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice
-        )
+            urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice,
+            max_offset=max_offset,
+        )  # fmt: skip
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None
     start, goal = (_joints(r, top[key], key, arm) for key in ("start", "goal"))
@@ -177,8 +187,9 @@ def _allowed(r: _Reader, value: Any) -> frozenset:
 
 
 def _fit_notice(line: str) -> None:
-    """A link cover that had to be fitted (not cached) takes seconds: say so on stderr."""
-    if "cached" not in line:
+    """A link cover that had to be fitted (not cached) takes seconds, and one that hit the
+    most bodies sticks out more than asked: say so on stderr."""
+    if "cached" not in line or "stopped at" in line:
         print(f"kcplan: covering {line}", file=sys.stderr, flush=True)
 
 

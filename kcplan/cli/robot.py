@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 import yaml
@@ -20,6 +21,10 @@ def _robot_yaml(cover, ratio: float, error: float) -> str:
         f"# sha256 {solid.digest}\n"
         f"# union volume / part volume {ratio:.4f} +- {error:.4f} (95 %, Monte Carlo)\n"
     )
+    if not math.isnan(cover.offset):
+        header += f"# sticks out of the part by at most {cover.offset:.6g}\n"
+    if cover.note:
+        header += f"# note: {cover.note}\n"
     body = yaml.safe_dump({"robot": cover.to_spec()}, sort_keys=False, default_flow_style=None)
     return header + body
 
@@ -34,6 +39,9 @@ def run_fit(args: argparse.Namespace) -> int:
 
     if args.bodies is not None and args.bodies > MAX_BODIES:
         raise InputError(f"--bodies: expected 1 to {MAX_BODIES}, got {args.bodies}")
+    if args.max_offset is not None and args.max_excess is not None:
+        raise InputError("--max-offset: expected --bodies (the most) or nothing beside it, "
+                         "got --max-excess too")  # fmt: skip
     try:
         solid = read_solid(args.mesh, args.scale, args.hull)
     except SolidError as err:
@@ -41,11 +49,16 @@ def run_fit(args: argparse.Namespace) -> int:
     report = sys.stdout if args.output else sys.stderr  # without -o the YAML goes to stdout
     shape = "sphere" if args.spheres else "ellipsoid"
     bodies = None if args.max_excess is not None else (args.bodies or 4)
+    if args.max_offset is not None:
+        bodies = args.bodies  # the most; fit_cover's default when not given
 
     def progress(line: str) -> None:
         print(f"  {line}", file=sys.stderr, flush=True)
 
-    cover = fit_cover(solid, bodies, args.max_excess, shape, progress)
+    try:
+        cover = fit_cover(solid, bodies, args.max_excess, shape, progress, args.max_offset)
+    except ValueError as err:  # a 2D outline with --max-offset
+        raise InputError(f"--max-offset: {err}") from None
     volume, error = union_volume(cover.bodies, TIGHTNESS_SAMPLES)
     ratio, error95 = volume / solid.volume, 1.96 * error / solid.volume
     unit = "area" if solid.dimension == 2 else "volume"
@@ -64,8 +77,14 @@ def run_fit(args: argparse.Namespace) -> int:
         f"(largest (x-p)^T M (x-p) = {cover.worst:.10f})",
         file=report,
     )
+    if not math.isnan(cover.offset):
+        print(
+            f"  sticks out of the part by at most {cover.offset:.6g} (a proved bound: every "
+            "point of every body within it of the part)",
+            file=report,
+        )
     if cover.note:
-        print(f"  {cover.note}", file=report)
+        print(f"  note: {cover.note}", file=report)
     text = _robot_yaml(cover, ratio, error95)
     if args.output:
         from kcplan.files import write_text_atomic
@@ -115,6 +134,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="X",
         help="instead of --bodies: the fewest bodies whose total volume is at most (1 + X) "
         "times the part's",
+    )
+    fit.add_argument(
+        "--max-offset",
+        type=positive_float,
+        metavar="D",
+        help="cut until no body sticks out of the part by more than D (the part's unit "
+        "times --scale; a proved bound), with --bodies as the most bodies (default "
+        "32); 3D parts only",
     )
     fit.add_argument(
         "--scale", type=positive_float, default=1.0, help="multiply coordinates (default 1)"

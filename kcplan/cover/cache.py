@@ -2,10 +2,13 @@
 
 Entries live in ``$KCPLAN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/kcplan/covers``, else
 ``~/.cache/kcplan/covers``), one JSON file per key: the SHA-256 of the mesh file's bytes
-and of the fit's parameters (bodies, scale, shape, hull, :data:`kcplan.cover.fit.FIT_VERSION`).
-An entry is never trusted: its bodies and cutting tree are re-derived and checked
-against the mesh (:func:`kcplan.cover.fit.check_cover`, the same hull points as the fit),
-and a stale, corrupt or failing entry is refitted and replaced. A cache folder that
+and of the fit's parameters (bodies, scale, shape, hull, max_offset,
+:data:`kcplan.cover.fit.FIT_VERSION`). An entry is never trusted for soundness: its bodies
+and cutting tree are re-derived and checked against the mesh
+(:func:`kcplan.cover.fit.check_cover`, the same hull points as the fit), and a stale,
+corrupt or failing entry is refitted and replaced. The offset bound of a ``max_offset``
+fit (:attr:`kcplan.cover.fit.Cover.offset`) is stored with the entry and read back as
+stored (re-proving it takes as long as a fit; no certificate relies on it). A cache folder that
 cannot be written is not an error; the cover is then fitted every time.
 """
 
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 from pathlib import Path
 
@@ -34,9 +38,9 @@ def cache_folder() -> Path:
     return Path(base) / "kcplan" / "covers"
 
 
-def _key(solid: Solid, bodies: int, scale: float, shape: str, hull: bool) -> str:
+def _key(solid: Solid, bodies: int | None, scale: float, shape: str, hull: bool, max_offset) -> str:
     params = {"file": solid.digest, "bodies": bodies, "scale": scale, "shape": shape}
-    params |= {"hull": hull, "version": FIT_VERSION}
+    params |= {"hull": hull, "max_offset": max_offset, "version": FIT_VERSION}
     return hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()
 
 
@@ -67,18 +71,23 @@ def _load(file: Path, key: str, solid: Solid, shape: str) -> Cover:
     worst = check_cover(solid, data["tree"], bodies)
     if not worst < 1.0:
         raise ValueError("bodies: a hull point lies outside its body")
-    return Cover(solid, bodies, data["tree"], shape, 0.0, str(data.get("note", "")), worst)
+    offset = float(data.get("offset", math.nan))
+    note = str(data.get("note", ""))
+    return Cover(solid, bodies, data["tree"], shape, 0.0, note, worst, offset)
 
 
 def cached_cover(
     path: str | os.PathLike,
-    bodies: int,
+    bodies: int | None,
     scale: float = 1.0,
     shape: str = "ellipsoid",
     hull: bool = False,
+    max_offset: float | None = None,
 ) -> tuple[Cover, str]:
-    """The cover of the part in ``path`` by ``bodies`` bodies, from the cache if a valid
-    entry exists, else fitted (and stored).
+    """The cover of the part in ``path`` by ``bodies`` bodies (or, with ``max_offset``,
+    by at most ``bodies`` that stick out of it by at most ``max_offset``:
+    :func:`kcplan.cover.fit.fit_cover`), from the cache if a valid entry exists, else
+    fitted (and stored).
 
     Returns
     -------
@@ -92,7 +101,7 @@ def cached_cover(
         For a part that cannot be read or covered.
     """
     solid = read_solid(path, scale, hull)
-    key = _key(solid, bodies, scale, shape, hull)
+    key = _key(solid, bodies, scale, shape, hull, max_offset)
     file = cache_folder() / f"{key}.json"
     origin = "fitted"
     if file.is_file():
@@ -100,8 +109,10 @@ def cached_cover(
             return _load(file, key, solid, shape), "cached"
         except (OSError, ValueError, KeyError, TypeError, AttributeError):
             origin = "refitted"
-    cover = fit_cover(solid, bodies=bodies, shape=shape)
+    cover = fit_cover(solid, bodies=bodies, shape=shape, max_offset=max_offset)
     entry = {"key": key, "source": os.fspath(path), "note": cover.note}
+    if not math.isnan(cover.offset):
+        entry["offset"] = cover.offset
     entry |= {"bodies": cover.to_spec()["bodies"], "tree": cover.tree}
     try:
         file.parent.mkdir(parents=True, exist_ok=True)

@@ -38,6 +38,7 @@ simplifies its hulls, so its pieces need not cover the part).
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -60,7 +61,7 @@ from kcplan.geometry.enclosing import (
 )
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 
-__all__ = ["FIT_VERSION", "SHAPES", "Cover", "check_cover", "fit_cover"]
+__all__ = ["FIT_VERSION", "MAX_OFFSET_BODIES", "SHAPES", "Cover", "check_cover", "fit_cover"]
 
 FIT_VERSION = 2
 """Changes whenever the fit would give other bodies for the same input (cache key)."""
@@ -86,6 +87,19 @@ SECTORS = True
 LOOKAHEAD = 3
 """When no single cut shrinks the union, this many best cuts of each leaf are tried as
 the first of two."""
+MAX_OFFSET_BODIES = 32
+"""Most bodies a ``max_offset`` fit uses by default (:data:`kcplan.geometry.robot.
+MAX_BODIES`, the most a robot may have)."""
+OFFSET_TOL = 0.1
+"""The offset bound of a body is refined until it is within this share of ``max_offset``
+of the attained distance, or proved to be below ``max_offset``."""
+OFFSET_SAMPLES = 300
+"""Surface points per child ellipsoid when candidate cuts are ranked by their offset."""
+OFFSET_FRACTIONS = (0.25, 0.375, 0.5, 0.625, 0.75)
+"""Where cuts of a ``max_offset`` fit cross a piece, as fractions of its extent along the
+cut's normal: balanced cuts only, since a body's offset shrinks with the size of its
+piece, and a cut that shaves a sliver off leaves the offset as it was (quantiles of the
+boundary points, as the volume fit uses, sit at the ends of a low-poly box)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,6 +131,10 @@ class Cover:
     note: str = ""
     worst: float = field(default=0.0)
     """The largest ``(x - p)^T M (x - p)`` of any hull point in its body (at most 1)."""
+    offset: float = field(default=math.nan)
+    """An upper bound of how far the cover sticks out of the part (the largest distance
+    from a point of a body to the part, :meth:`kcplan.cover.offset.OffsetMeter.bound`),
+    in the part's unit; ``nan`` when the fit did not measure it."""
 
     @property
     def robot(self) -> Robot:
@@ -437,6 +455,7 @@ def fit_cover(
     max_excess: float | None = None,
     shape: str = "ellipsoid",
     progress: Callable[[str], None] | None = None,
+    max_offset: float | None = None,
 ) -> Cover:
     """Cover a part by at most ``bodies`` ellipsoids (see the module docstring).
 
@@ -452,14 +471,31 @@ def fit_cover(
         ``ellipsoid`` (default) or ``sphere``.
     progress : callable, optional
         Called with one line per body added.
+    max_offset : float, optional
+        Instead of ``max_excess``, and with ``bodies`` as the most bodies (default
+        :data:`MAX_OFFSET_BODIES`): cut until no body sticks out of the part by more than
+        this (part's unit; proved, :mod:`kcplan.cover.offset`), splitting the body that
+        sticks out most (see the module docstring). When the most bodies are not enough,
+        :attr:`Cover.note` says so and by how much the cover still sticks out.
 
     Returns
     -------
     Cover
         ``cover.worst <= 1``: every hull point of every piece is in its body.
+        ``cover.offset`` bounds how far it sticks out (``nan`` when not measured).
     """
     if shape not in SHAPES:
         raise ValueError(f"shape: expected one of {', '.join(SHAPES)}, got {shape!r}")
+    if max_offset is not None:
+        if max_excess is not None:
+            raise ValueError("expected at most one of max_excess and max_offset")
+        if not (isinstance(max_offset, (int, float)) and max_offset > 0):
+            raise ValueError(f"max_offset: expected a positive number, got {max_offset}")
+        if solid.dimension != 3:
+            raise ValueError(f"max_offset: expected a 3D part, got a {solid.dimension}D one")
+        if bodies is not None and not 1 <= bodies <= MAX_BODIES:
+            raise ValueError(f"bodies: expected 1 to {MAX_BODIES}, got {bodies}")
+        return _fit_offset(solid, bodies or MAX_OFFSET_BODIES, float(max_offset), shape, progress)
     if (bodies is None) == (max_excess is None):
         raise ValueError("expected exactly one of bodies and max_excess")
     if bodies is not None and not 1 <= bodies <= MAX_BODIES:
@@ -556,6 +592,101 @@ def _grow(
         growth.trail[len(leaves)] = search.union(leaves)
         report(len(leaves))
     return growth
+
+
+def _fit_offset(
+    solid: Solid, most: int, max_offset: float, shape: str, progress: Callable[[str], None] | None
+) -> Cover:
+    """Cut until every body sticks out of the part by at most ``max_offset`` (proved by
+    :meth:`OffsetMeter.bound`), or until ``most`` bodies (see :func:`fit_cover`)."""
+    from kcplan.cover.offset import OffsetMeter
+
+    start = time.perf_counter()
+    tol = OFFSET_TOL * max_offset
+    meter = OffsetMeter(solid, min(solid.size / 100.0, 0.5 * tol))
+    search = _Search(solid, shape, pencils=False)
+    leaves = [search.root]
+    bounds: dict[int, tuple[Body, object]] = {}  # id(leaf) -> (its body, its offset bound)
+    note = ""
+    while True:
+        for leaf in leaves:
+            if id(leaf) not in bounds:
+                body = _sound_body(leaf, shape)
+                bounds[id(leaf)] = (body, meter.bound(body, tol, below=max_offset))
+        over = [k for k, leaf in enumerate(leaves) if bounds[id(leaf)][1].high > max_offset]
+        if not over:
+            break
+        if len(leaves) >= most:
+            for leaf in (leaves[k] for k in over):  # the value, not just "above"
+                body = bounds[id(leaf)][0]
+                bounds[id(leaf)] = (body, meter.bound(body, tol))
+            worst = max(bounds[id(leaf)][1].high for leaf in leaves)
+            note = (
+                f"stopped at {most} bodies, the most asked for: {len(over)} still stick out "
+                f"by more than {max_offset:.4g} (up to {worst:.4g})"
+            )
+            break
+        k = max(over, key=lambda j: meter.estimate(bounds[id(leaves[j])][0]))
+        normal, offset = _offset_cut(search, meter, leaves[k], shape)
+        leaf = leaves.pop(k)
+        children = search.children(leaf, normal, offset)
+        leaf.node |= {"plane": [*normal.tolist(), float(offset)]}
+        leaf.node |= {"below": children[0].node, "above": children[1].node}
+        leaves += children
+        if progress is not None:
+            progress(f"offset: {len(leaves)} bodies, {time.perf_counter() - start:.1f} s")
+    out = []
+    for k, leaf in enumerate(leaves):
+        leaf.node["body"] = k
+        out.append(bounds[id(leaf)][0])
+    worst = max(body_holds(body, leaf.points) for body, leaf in zip(out, leaves, strict=True))
+    offset_high = max(bounds[id(leaf)][1].high for leaf in leaves)
+    seconds = time.perf_counter() - start
+    return Cover(solid, tuple(out), search.root.node, shape, seconds, note, worst, offset_high)
+
+
+def _offset_cut(search: _Search, meter, leaf: _Leaf, shape: str) -> tuple[NDArray, float]:
+    """The candidate cut of ``leaf`` whose two children stick out least (the larger of
+    their sampled offsets, then their sum; each child's ellipsoid fitted to its full hull
+    points at the search tolerance). Candidates: :meth:`_Search.planes`, and planes across
+    the direction in which the leaf's body sticks out most, at :data:`CUT_QUANTILES`."""
+    best, best_key = None, (np.inf, np.inf)
+    _, n = meter.witness(_sound_body(leaf, shape), OFFSET_SAMPLES)
+    V = leaf.piece.boundary_points
+    planes = [
+        (normal, float(offset))
+        for normal in ([n] if n.any() else []) + _directions(leaf.M)
+        for offset in _spread(V @ normal)
+    ]
+    for normal, offset in planes:
+        if not _crossing(V, normal[None], np.array([offset]))[0]:
+            continue  # a child without volume
+        estimates = []
+        for sign in (1.0, -1.0):
+            piece = leaf.piece.cut(sign * normal, sign * offset)
+            points = piece.points(search.solid.boundary)
+            if len(piece.boundary) == 0 or len(points) == 0:
+                break
+            try:  # the same ellipsoid holds the points and their hull's corners
+                points = points[ConvexHull(points).vertices]
+            except (QhullError, ValueError):
+                pass
+            c, M = _enclosing(points, shape, SEARCH_TOL)
+            body = body_from_ellipsoid(c, M, sphere=shape == "sphere")
+            estimates.append(meter.estimate(body, OFFSET_SAMPLES))
+        else:
+            key = (max(estimates), sum(estimates))
+            if key < best_key:
+                best, best_key = (normal, offset), key
+    if best is None:  # pragma: no cover - a piece with volume always has a crossing plane
+        raise RuntimeError("no candidate cut splits the piece")
+    return best
+
+
+def _spread(x: NDArray) -> NDArray:
+    """Points at :data:`OFFSET_FRACTIONS` of the range of ``x``."""
+    low, high = float(x.min()), float(x.max())
+    return low + (high - low) * np.asarray(OFFSET_FRACTIONS)
 
 
 def _stopped(count: int, why: str) -> str:
