@@ -82,7 +82,7 @@ def test_accepted_arm_edges_are_free_on_the_meshes(panda, scene):
     assert accepted > 10 and short_accepted >= 0.5 * short
     c = certifier.counters
     assert c["edges"] == c["rejected"] + accepted
-    reasons = ("rejected_end_state", "rejected_guard", "not_proven")
+    reasons = ("rejected_end_state", "rejected_probe", "rejected_guard", "not_proven")
     assert sum(c[k] for k in reasons) == c["rejected"]
 
 
@@ -98,7 +98,12 @@ def test_an_edge_that_meets_the_scene_midway_is_rejected(panda, scene):
     check = verify_arm_path(panda, obstacles, [q1, q2])
     assert check.collides and 0.4 < check.where[1] < 0.7
     assert not certifier.check(q1, q2) and not certifier.check(q2, q1)
-    assert certifier.counters["rejected_guard"] + certifier.counters["not_proven"] == 2
+    c = certifier.counters
+    assert c["rejected_probe"] == 2 and c["guards"] == 0  # a probe hit it before any guard
+    unprobed = ArmEdgeCertifier(world, probes=False)
+    assert not unprobed.check(q1, q2) and not unprobed.check(q2, q1)
+    c = unprobed.counters
+    assert c["rejected_guard"] + c["not_proven"] == 2 and c["probes"] == 0 and c["guards"] > 2
 
 
 def test_states_outside_the_limits_are_never_free(panda, scene):

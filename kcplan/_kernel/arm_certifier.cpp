@@ -15,6 +15,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       chain_(world.chain()),
       n_(world.chain().dof()),
       max_guards_(options.max_guards),
+      probes_(options.probes),
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
       rho_pairs_(world.chain().relative_speeds(world.pairs())) {
@@ -29,6 +30,33 @@ bool ArmCertifier::reject(std::int64_t& reason) {
   ++counters.rejected;
   ++reason;
   return false;
+}
+
+bool ArmCertifier::certified_by_endpoints() {
+  ++counters.certified_by_endpoints;
+  covered_ball += 1.0;
+  return true;
+}
+
+bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double hi,
+                         double length) {
+  const double wanted = (hi - lo) * length / kProbeStep;
+  const int count = wanted >= kMaxProbes ? kMaxProbes : static_cast<int>(wanted);
+  if (count == 0) return true;
+  ++counters.probed_edges;
+  // the van der Corput points 1/2, 1/4, 3/4, 1/8, ...: each halves the largest stretch
+  // left unprobed, as bisection would (kcplan/planning/certifier.py probe_points)
+  for (int i = 1; i <= count; ++i) {
+    double u = 0.0, bit = 0.5;
+    for (int k = i; k > 0; k >>= 1, bit *= 0.5)
+      if (k & 1) u += bit;
+    const double s = lo + u * (hi - lo);
+    for (int j = 0; j < n_; ++j) q_[j] = q1[j] + s * (q2[j] - q1[j]);
+    ++counters.probes;
+    ++counters.collision_queries;
+    if (world_.in_collision(q_.data())) return false;
+  }
+  return true;
 }
 
 bool ArmCertifier::state_valid(const double* q) {
@@ -138,17 +166,32 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * q_[j];
     pair_speed_[m] = v;
   }
-  const double lo =
-      radius(*endpoint(q1, ArmGuardCache::key_of(q1, n_)), speed_, pair_speed_, 1.0);
-  if (lo <= 0.0) return reject(c.rejected_guard);
-  const double hi = 1.0 - radius(*endpoint(q2, ArmGuardCache::key_of(q2, n_)), speed_,
-                                 pair_speed_, 1.0 - lo);
-  if (hi >= 1.0) return reject(c.rejected_end_state);
-  if (lo >= hi) {
-    ++c.certified_by_endpoints;
-    covered_ball += 1.0;
-    return true;
+  const ArmGuardCache::Key k1 = ArmGuardCache::key_of(q1, n_), k2 = ArmGuardCache::key_of(q2, n_);
+  std::shared_ptr<const ArmGuard> g1 = cache_.guard(k1), g2 = cache_.guard(k2);
+  double lo = 0.0, hi = 1.0;
+  if (g1) {
+    ++c.cached_guards;
+    lo = radius(*g1, speed_, pair_speed_, 1.0);
   }
+  if (g2 && lo < 1.0) {
+    ++c.cached_guards;
+    hi = 1.0 - radius(*g2, speed_, pair_speed_, 1.0 - lo);
+  }
+  if (lo >= hi) return certified_by_endpoints();
+  if (probes_) {
+    double length = 0.0;
+    for (int j = 0; j < n_; ++j) length += (q2[j] - q1[j]) * (q2[j] - q1[j]);
+    if (!probe(q1, q2, lo, hi, std::sqrt(length))) return reject(c.rejected_probe);
+  }
+  if (!g1) {
+    lo = radius(*endpoint(q1, k1), speed_, pair_speed_, 1.0);
+    if (lo <= 0.0) return reject(c.rejected_guard);
+  }
+  if (!g2 && lo < hi) {
+    hi = 1.0 - radius(*endpoint(q2, k2), speed_, pair_speed_, 1.0 - lo);
+    if (hi >= 1.0) return reject(c.rejected_end_state);
+  }
+  if (lo >= hi) return certified_by_endpoints();
   std::vector<double> q(n_);
   int guards = 0;
   const Advanced outcome = advance(

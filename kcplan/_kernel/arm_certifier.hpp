@@ -36,6 +36,7 @@ using ArmGuardCache = StateCache<Chain::kMaxJoints, ArmGuard>;
 /// Options of an ArmCertifier; the defaults are the Python certifier's.
 struct ArmCertifierOptions {
   int max_guards = 256;  ///< guards per edge after the endpoints before "not proven"
+  bool probes = true;    ///< collision probes of the open stretch before any guard
   std::size_t cache_entries = 200000;
 };
 
@@ -51,9 +52,12 @@ struct ArmCertifierOptions {
 ///
 /// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
 /// outside the limits or not finite rejects the edge with no query; (2) q2's validity
-/// (one collision query, cached); (3) guards at both ends (cached per state); (4) a guard
-/// in the middle of each stretch left open until none is (certified), one is in contact
-/// (rejected) or max_guards were placed ("not proven", rejected). A self pair's exact
+/// (one collision query, cached); (3) the ends' cached guards, which may certify it; (4)
+/// probes: collision queries at the van der Corput points of the stretch left open, one
+/// per kProbeStep of joint-space distance (at most kMaxProbes), a colliding one rejects
+/// at a collision query's price; (5) the missing end guards (cached per state); (6) a
+/// guard in the middle of each stretch left open until none is (certified), one is in
+/// contact (rejected) or max_guards were placed ("not proven", rejected). A self pair's exact
 /// distance is asked only when its balls' gap would limit a radius: the radius is then
 /// exactly the one of exact distances. Not thread-safe (the world's objects are reused).
 class ArmCertifier {
@@ -81,10 +85,15 @@ class ArmCertifier {
   /// Caps are this much above what a stretch needs, so that the radius they give, less
   /// its rounding margin, still covers the stretch.
   static constexpr double kCapSlack = 1.0 + 1e-6;
+  /// Joint-space distance (radians, L2) per probe, and probes per edge at most
+  /// (kcplan/planning/arm_certifier.py: PROBE_STEP, MAX_PROBES).
+  static constexpr double kProbeStep = 0.1;
+  static constexpr int kMaxProbes = 64;
 
   ArmWorld& world() { return world_; }
   const ArmGuardCache& cache() const { return cache_; }
   int max_guards() const { return max_guards_; }
+  bool probes() const { return probes_; }
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
   CertifierCounters counters;
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
@@ -93,10 +102,13 @@ class ArmCertifier {
  private:
   std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);
   bool reject(std::int64_t& reason);
+  bool certified_by_endpoints();
+  bool probe(const double* q1, const double* q2, double lo, double hi, double length);
 
   ArmWorld& world_;
   const Chain& chain_;
   int n_, max_guards_;
+  bool probes_;
   ArmGuardCache cache_;
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> speed_, pair_speed_, q_, caps_;

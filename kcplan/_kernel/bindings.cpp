@@ -320,12 +320,13 @@ NB_MODULE(_core, m) {
       .def(
           "__init__",
           [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
-             std::size_t cache_entries) {
+             std::size_t cache_entries, bool probes) {
             kcplan::ArmCertifierOptions o;
-            o.max_guards = max_guards, o.cache_entries = cache_entries;
+            o.max_guards = max_guards, o.cache_entries = cache_entries, o.probes = probes;
             new (self) kcplan::ArmCertifier(world, o);
           },
-          "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, nb::keep_alive<1, 2>())
+          "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
+          nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();
@@ -350,5 +351,6 @@ NB_MODULE(_core, m) {
         return d;
       })
       .def_prop_ro("cache_size", [](const kcplan::ArmCertifier& c) { return c.cache().size(); })
-      .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards);
+      .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards)
+      .def_prop_ro("probes", &kcplan::ArmCertifier::probes);
 }

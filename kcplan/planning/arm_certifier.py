@@ -15,6 +15,13 @@ The covers contain the links' collision geometry, so the links are free too. The
 certified when guards cover all of ``[0, 1]``; a guard at a state in contact (``r = 0``)
 rejects it.
 
+Before any guard is paid for, *probes* look for a colliding state on the stretch the
+cached guards left open: collision queries at the van der Corput points of that stretch
+(1/2, 1/4, 3/4, ...), one per :data:`PROBE_STEP` radians of joint-space distance, at most
+:data:`MAX_PROBES`. A colliding probe proves the edge not free at a collision query's
+price (a guard costs a distance query of every body and pair); they cost the certified
+edges a few cheap queries each.
+
 This is the ``ca`` certificate of arms (the rigid robots' clearance ball with the chain's
 speeds); it imports neither OMPL nor FCL (the world does the queries).
 """
@@ -28,20 +35,26 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from kcplan.arm.bounds import carries, point_speeds, relative_speeds
-from kcplan.planning.certifier import COUNTER_NAMES, advance
+from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
 from kcplan.planning.guard import GuardCache
 
-__all__ = ["ARM_COUNTER_NAMES", "ArmEdgeCertifier", "ArmGuard"]
+__all__ = ["ARM_COUNTER_NAMES", "MAX_PROBES", "PROBE_STEP", "ArmEdgeCertifier", "ArmGuard"]
 
 ARM_COUNTER_NAMES = tuple(
     name
     for name in COUNTER_NAMES
-    if name not in ("rejected_sweep", "rejected_occupancy", "rejected_probe", "probes")
-    and name not in ("probed_edges", "occupancy_rejections", "occupancy_queries")
+    if name not in ("rejected_sweep", "rejected_occupancy")
+    and name not in ("occupancy_rejections", "occupancy_queries")
 )
 """The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
-the same meanings, less those of the steps arms do not have yet (core sweep, occupancy
-grid, probes)."""
+the same meanings, less those of the steps arms do not have (core sweep, occupancy
+grid)."""
+
+PROBE_STEP = 0.1
+"""Joint-space distance (radians, L2 of the joint vector) per probe; the kernel's twin is
+``ArmCertifier::kProbeStep``. OMPL's default discrete check of the Panda steps 0.134."""
+MAX_PROBES = 64
+"""Probes per edge at most (``ArmCertifier::kMaxProbes``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,16 +77,20 @@ class ArmEdgeCertifier:
 
     ``check(q1, q2)`` follows OMPL's ``MotionValidator`` contract: ``q1`` is assumed valid,
     ``q2`` is not. Steps: (1) a state outside the joint limits or not finite rejects the
-    edge with no query; (2) ``q2``'s validity (one collision query, cached); (3) guards at
-    the two ends (cached per state, as the rigid certifier caches them); (4) a guard in
-    the middle of each stretch left open until none is (certified), one is in contact
-    (rejected) or ``max_guards`` were placed ("not proven", rejected).
+    edge with no query; (2) ``q2``'s validity (one collision query, cached); (3) the
+    cached guards of its ends, which may certify it with no query; (4) probes of the
+    stretch they leave open; (5) the missing end guards (measured and cached per state, as
+    the rigid certifier caches them); (6) a guard in the middle of each stretch left open
+    until none is (certified), one is in contact (rejected) or ``max_guards`` were placed
+    ("not proven", rejected).
 
     Parameters
     ----------
     world : kcplan.arm.ArmWorld
     max_guards : int
         Guards per edge after the ends before "not proven".
+    probes : bool
+        Probe the stretch left open before the guards (module docstring).
     cache_entries : int
         States whose validity and guard are remembered (the rigid certifier's
         :class:`kcplan.planning.guard.GuardCache`: the oldest are dropped first).
@@ -82,8 +99,11 @@ class ArmEdgeCertifier:
     backend = "python"
     certificates = ("ball",)
 
-    def __init__(self, world, max_guards: int = 256, cache_entries: int = 200_000):
+    def __init__(
+        self, world, max_guards: int = 256, cache_entries: int = 200_000, probes: bool = True
+    ):
         self.world, self.arm = world, world.arm
+        self.probes = bool(probes)
         self.n = self.arm.dof
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
@@ -156,17 +176,47 @@ class ArmEdgeCertifier:
         dq = np.abs(q2 - q1)
         speed = self._rho @ dq
         pair_speed = self._rho_pairs @ dq
-        lo = self._radius(self._endpoint(q1), speed, pair_speed)
-        if lo <= 0.0:
-            return self._reject("rejected_guard")
-        hi = 1.0 - self._radius(self._endpoint(q2), speed, pair_speed)
-        if hi >= 1.0:
-            return self._reject("rejected_end_state")
+        g1, g2 = self.cache.guard(q1.tobytes()), self.cache.guard(q2.tobytes())
+        lo, hi = 0.0, 1.0
+        if g1 is not None:
+            c["cached_guards"] += 1
+            lo = self._radius(g1, speed, pair_speed)
+        if g2 is not None and lo < 1.0:
+            c["cached_guards"] += 1
+            hi = 1.0 - self._radius(g2, speed, pair_speed)
         if lo >= hi:
-            c["certified_by_endpoints"] += 1
-            self.covered["ball"] += 1.0
-            return True
+            return self._certified_by_endpoints()
+        if self.probes and not self._probe(q1, q2, lo, hi, _length(q2 - q1)):
+            return self._reject("rejected_probe")
+        if g1 is None:
+            lo = self._radius(self._endpoint(q1), speed, pair_speed)
+            if lo <= 0.0:
+                return self._reject("rejected_guard")
+        if g2 is None and lo < hi:
+            hi = 1.0 - self._radius(self._endpoint(q2), speed, pair_speed)
+            if hi >= 1.0:
+                return self._reject("rejected_end_state")
+        if lo >= hi:
+            return self._certified_by_endpoints()
         return self._advance(q1, q2, lo, hi, speed, pair_speed)
+
+    def _certified_by_endpoints(self) -> bool:
+        self.counters["certified_by_endpoints"] += 1
+        self.covered["ball"] += 1.0
+        return True
+
+    def _probe(self, q1, q2, lo: float, hi: float, length: float) -> bool:
+        """False when a probe of ``[lo, hi]`` collides (module docstring)."""
+        count = min(MAX_PROBES, int((hi - lo) * length / PROBE_STEP))
+        if count == 0:
+            return True
+        self.counters["probed_edges"] += 1
+        for u in probe_points(count):
+            self.counters["probes"] += 1
+            self.counters["collision_queries"] += 1
+            if self.world.in_collision(q1 + (lo + u * (hi - lo)) * (q2 - q1)):
+                return False
+        return True
 
     def _advance(self, q1, q2, lo, hi, speed, pair_speed) -> bool:
         def reach(m: float, s0: float, s1: float) -> tuple[float, float] | None:
@@ -180,3 +230,8 @@ class ArmEdgeCertifier:
         self.counters["certified_one_guard"] += guards == 1
         self.covered["ball"] += 1.0
         return True
+
+
+def _length(dq: np.ndarray) -> float:
+    """``|dq|`` summed in order, as the kernel sums it (the probe count is its floor)."""
+    return math.sqrt(sum(float(d) * float(d) for d in dq))

@@ -146,7 +146,7 @@ class KernelArmCertifier:
     world : kcplan.arm.ArmWorld
         Its :attr:`~kcplan.arm.ArmWorld.kernel` is used (built on first use); the
         certifier's queries show in ``world.counters``.
-    max_guards, cache_entries
+    max_guards, cache_entries, probes
         As for :class:`~kcplan.planning.arm_certifier.ArmEdgeCertifier`.
 
     Notes
@@ -159,10 +159,14 @@ class KernelArmCertifier:
     certificates = ("ball",)
     fallback = "bisection"
 
-    def __init__(self, world, max_guards: int = 256, cache_entries: int = 200_000):
+    def __init__(
+        self, world, max_guards: int = 256, cache_entries: int = 200_000, probes: bool = True
+    ):
         self.world = world
         self.n = world.arm.dof
-        self.compiled = _CompiledArmCertifier(world.kernel, int(max_guards), int(cache_entries))
+        self.compiled = _CompiledArmCertifier(
+            world.kernel, int(max_guards), int(cache_entries), bool(probes)
+        )
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have

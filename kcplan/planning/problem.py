@@ -516,7 +516,7 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     validator = None
     n = arm.dof
     if spec.kc:
-        validator = KCMotionValidator(si, arm, world, backend=spec.backend)
+        validator = KCMotionValidator(si, arm, world, backend=spec.backend, probes=spec.probes)
         si.setMotionValidator(validator)
         state_valid = validator.state_valid
     elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand

@@ -116,7 +116,7 @@ class KCMotionValidator(ob.MotionValidator):
         self.space = si.getStateSpace()  # not si itself: see the module docstring
         self.error: Exception | None = None
         if isinstance(world, ArmWorld):
-            self._init_arm(robot, world, certificates, fallback, max_guards, backend)
+            self._init_arm(robot, world, certificates, fallback, max_guards, backend, probes)
             return
         max_guards = 64 if max_guards is None else max_guards
         robot = Robot.of(robot)
@@ -155,7 +155,7 @@ class KCMotionValidator(ob.MotionValidator):
             if fallback != "discrete":  # the discrete fallback needs OMPL's resolution
                 self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
 
-    def _init_arm(self, arm, world, certificates, fallback, max_guards, backend) -> None:
+    def _init_arm(self, arm, world, certificates, fallback, max_guards, backend, probes) -> None:
         if arm is not world.arm:
             raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
         backend = "kernel" if backend is None else backend
@@ -168,13 +168,13 @@ class KCMotionValidator(ob.MotionValidator):
             )
         max_guards = 256 if max_guards is None else max_guards
         if backend == "kernel":
-            self.certifier = KernelArmCertifier(world, max_guards)
+            self.certifier = KernelArmCertifier(world, max_guards, probes=probes > 0)
             compiled, n = self.certifier.compiled, arm.dof
             # the hot path: one call into the kernel with the two joint vectors
             self.state_valid = lambda s: compiled.state_valid([s[j] for j in range(n)])
             self.checkMotion = self._check_kernel_arm
         else:
-            self.certifier = ArmEdgeCertifier(world, max_guards)
+            self.certifier = ArmEdgeCertifier(world, max_guards, probes=probes > 0)
         self.backend = backend
         self.n = arm.dof
         self._read = lambda state, n=arm.dof: joint_state(state, n)
