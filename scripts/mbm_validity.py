@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     for bodies, max_offset in covers:
         t0 = time.perf_counter()
         arm = load_arm(args.urdf, joints, srdf=args.srdf, bodies_per_link=bodies,
-                       max_offset=max_offset)  # fmt: skip
+                       max_offset=max_offset, progress=_fitted)  # fmt: skip
         label = f"{bodies}" if max_offset is None else f"<= {1000 * max_offset:g} mm"
         arms.append((label, bodies, max_offset, arm))
         notes.append(f"{label}: {len(arm.bodies)} bodies, {len(arm.self_pairs)} self pairs, "
@@ -99,6 +99,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.offsets:
         print_offsets(arms)
     return 0
+
+
+def _fitted(line: str) -> None:
+    """Say how long each link's cover took when it was fitted (not cached)."""
+    if "cached" not in line:
+        print(f"- covered {line}", flush=True)
 
 
 def print_offsets(arms: list) -> None:

@@ -322,3 +322,62 @@ def test_bad_mbm_files_are_refused_with_one_line(tmp_path):
         read_mbm_archive(MBM, "shelf", 1)
     with pytest.raises(MbmError, match=r"expected one box scene 101, found 0"):
         read_mbm_archive(MBM, "box", 101)
+
+
+def _bracket_arm(tmp_path) -> Path:
+    """A one-joint URDF whose link is the L bracket mesh (60 mm, 20 triangles)."""
+    import shutil
+
+    shutil.copy(ROOT / "scenarios" / "3d" / "meshes" / "l_bracket.stl", tmp_path / "b.stl")
+    urdf = tmp_path / "bracket.urdf"
+    urdf.write_text(
+        "<robot name='b'><link name='base'/><link name='arm'><collision><geometry>"
+        "<mesh filename='b.stl'/></geometry></collision></link>"
+        "<joint name='j' type='revolute'><parent link='base'/><child link='arm'/>"
+        "<axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint></robot>"
+    )
+    return urdf
+
+
+def test_link_covers_are_cut_until_they_stick_out_at_most_max_offset(tmp_path, monkeypatch):
+    """Issue 25 item 5: ``max_offset`` cuts a link's cover until the proved offset is
+    within it (the progress line says how far, and that the most bodies were hit when
+    they were); ``bodies_per_link`` alone keeps the fixed count; neither is the
+    default offset; a bad value is one line naming the field."""
+    from kcplan.arm.model import DEFAULT_MAX_OFFSET, mesh_cover
+    from kcplan.world import ScenarioError, load_scenario
+
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path / "cache"))
+    urdf = _bracket_arm(tmp_path)
+    lines: list[str] = []
+    arm = load_arm(urdf, ["j"], max_offset=0.006, progress=lines.append)
+    cover, _ = mesh_cover(tmp_path / "b.stl", None, max_offset=0.006)
+    assert cover.offset <= 0.006 and len(arm.bodies) == len(cover.bodies) > 1
+    assert "sticking out by at most" in lines[0] and "stopped at" not in lines[0]
+    assert len(arm.self_pairs) == 0
+    capped: list[str] = []
+    assert (
+        len(
+            load_arm(
+                urdf, ["j"], bodies_per_link=2, max_offset=0.006, progress=capped.append
+            ).bodies
+        )
+        == 2
+    )
+    assert "stopped at 2 bodies, the most asked for" in capped[0]
+    assert len(load_arm(urdf, ["j"], bodies_per_link=2).bodies) == 2
+    default = load_arm(urdf, ["j"])
+    same = load_arm(urdf, ["j"], max_offset=DEFAULT_MAX_OFFSET)
+    assert [b.semi_axes.tolist() for b in default.bodies] == [
+        b.semi_axes.tolist() for b in same.bodies
+    ]
+    for bad in (-1.0, 0.0, math.nan):
+        with pytest.raises(ArmError, match=r"bracket\.urdf: max_offset: expected a positive"):
+            load_arm(urdf, ["j"], max_offset=bad)
+    scenario = tmp_path / "s.yaml"
+    robot = f"{{urdf: {urdf}, joints: [j], max_offset: -1}}"
+    scenario.write_text(
+        f"name: s\nrobot: {robot}\nstart: {{joints: [0]}}\ngoal: {{joints: [0.5]}}\n"
+    )
+    with pytest.raises(ScenarioError, match=r"robot\.max_offset: expected a positive number"):
+        load_scenario(scenario)

@@ -701,3 +701,136 @@ def test_offsets_measure_how_far_a_cover_sticks_out(tmp_path):
     (tmp_path / "square.yaml").write_text(yaml.safe_dump({"vertices": [[0, 0], [1, 0], [1, 1]]}))
     with pytest.raises(ValueError, match="expected a 3D part"):
         cover_offsets(read_solid(tmp_path / "square.yaml"), [ball])
+
+
+# ---------------------------------------------------------------- covers by how far they stick out
+
+
+def _inside_by_parity(points: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Whether each point is inside the closed mesh of triangles ``T``, by the parity of the
+    crossings of the ray from the point along +x (independent of winding numbers; a ray
+    grazing an edge counts wrong with probability zero for random points)."""
+    out = np.zeros(len(points), dtype=bool)
+    a, b, c = T[:, 0, 1:], T[:, 1, 1:], T[:, 2, 1:]
+    normal = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+    for i, p in enumerate(points):
+
+        def side(u, v, p=p[1:]):
+            return (v[:, 0] - u[:, 0]) * (p[1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (p[0] - u[:, 0])
+
+        s1, s2, s3 = side(a, b), side(b, c), side(c, a)
+        hit = ((s1 > 0) & (s2 > 0) & (s3 > 0)) | ((s1 < 0) & (s2 < 0) & (s3 < 0))
+        n, t0 = normal[hit], T[hit, 0]
+        x = t0[:, 0] - (n[:, 1] * (p[1] - t0[:, 1]) + n[:, 2] * (p[2] - t0[:, 2])) / n[:, 0]
+        out[i] = (x > p[0]).sum() % 2 == 1
+    return out
+
+
+def _sampled_offset(bodies, mesh: trimesh.Trimesh, count: int, seed: int = 0) -> float:
+    """The largest distance to the mesh of ``count`` random points per body, inside and on
+    it, measured independently of kcplan.cover.offset: scipy's rotation of the stored
+    quaternion, ray parity for inside, trimesh's closest points for the distance."""
+    from scipy.spatial.transform import Rotation
+    from trimesh.triangles import closest_point
+
+    rng = np.random.default_rng(seed)
+    T = mesh.vertices[mesh.faces]
+    worst = 0.0
+    for body in bodies:
+        u = rng.normal(size=(count, 3))
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        u[: count // 2] *= rng.uniform(size=(count // 2, 1)) ** (1 / 3)  # half inside
+        R = Rotation.from_quat(body.pose[3:]).as_matrix()
+        points = (u * body.semi_axes) @ R.T + body.position
+        outside = points[~_inside_by_parity(points, T)]
+        if len(outside) == 0:
+            continue
+        pairs_p = np.repeat(outside, len(T), axis=0)
+        pairs_t = np.tile(T, (len(outside), 1, 1))
+        d = np.linalg.norm(closest_point(pairs_t, pairs_p) - pairs_p, axis=1)
+        worst = max(worst, float(d.reshape(len(outside), len(T)).min(axis=1).max()))
+    return worst
+
+
+def test_the_offset_bound_holds_the_exact_offset_of_the_ball_around_a_cube(tmp_path):
+    """The ball of radius h sqrt(3) about a cube of half side h sticks out by exactly
+    h (sqrt(3) - 1) (at the face centres); the bound brackets it within its tolerance and
+    the sample spacing, a ball inside the cube is proved to stick out by nothing, and
+    ``below`` answers the question asked (proved under, or a point over)."""
+    from kcplan.cover.offset import OffsetMeter
+    from kcplan.geometry.robot import Body
+
+    h = 0.5
+    trimesh.creation.box(extents=[2 * h] * 3).export(tmp_path / "cube.stl")
+    meter = OffsetMeter(read_solid(tmp_path / "cube.stl"), h=0.002)
+    ball = Body(np.full(3, h * math.sqrt(3)), np.array([0.0, 0, 0, 0, 0, 0, 1]))
+    inner = Body(np.full(3, 0.4), np.array([0.05, 0, 0, 0, 0, 0, 1]))
+    exact = h * (math.sqrt(3) - 1)
+    bound = meter.bound(ball, 0.002)
+    assert bound.low <= exact <= bound.high <= bound.low + 0.002 + meter.h + 1e-9
+    assert meter.bound(inner, 0.002).high == 0.0
+    assert meter.bound(ball, 0.002, below=0.4).high <= 0.4
+    assert meter.bound(ball, 0.002, below=0.3).low > 0.3
+
+
+def test_a_max_offset_fit_sticks_out_at_most_that_far_and_stays_sound(tmp_path):
+    """The L bracket (20 triangles, 60 mm) covered to stick out by at most 6 mm: the fit's
+    proved bound is within it, so is every one of 400 independent random points per body
+    (inside and on it), and every sample of the part lies in the cover. With only 3 bodies
+    allowed the fit stops there, says so, and its bound is still sound (no point beyond
+    it) and above 6 mm."""
+    solid, mesh = read_solid(MESHES / "l_bracket.stl"), _mesh(MESHES / "l_bracket.stl")
+    cover = fit_cover(solid, max_offset=0.006)
+    assert cover.note == "" and 4 <= len(cover.bodies) <= 32
+    assert cover.offset <= 0.006
+    assert _sampled_offset(cover.bodies, mesh, 400) <= cover.offset
+    _assert_covered(solid, cover, mesh, SAMPLES)
+    few = fit_cover(solid, bodies=3, max_offset=0.006)
+    assert len(few.bodies) == 3 and few.offset > 0.006
+    assert re.fullmatch(
+        r"stopped at 3 bodies, the most asked for: \d still stick out by more than 0\.006 "
+        r"\(up to 0\.0\d+\)",
+        few.note,
+    )
+    assert 0.006 < _sampled_offset(few.bodies, mesh, 400) <= few.offset
+    _assert_covered(solid, few, mesh, SAMPLES)
+
+
+def test_robot_fit_max_offset_reports_the_bound_the_cap_and_bad_input(tmp_path, capsys):
+    path, out = str(MESHES / "l_bracket.stl"), tmp_path / "b.yaml"
+    assert (
+        main(["robot", "fit", path, "--max-offset", "0.006", "--bodies", "3", "-o", str(out)]) == 0
+    )
+    text = capsys.readouterr().out
+    assert "3 ellipsoids" in text and "sticks out of the part by at most 0.0" in text
+    assert "note: stopped at 3 bodies, the most asked for" in text
+    header = out.read_text()
+    assert "# sticks out of the part by at most" in header and "# note: stopped at 3" in header
+    assert len(yaml.safe_load(header)["robot"]["bodies"]) == 3
+    square = _write(tmp_path, "sq.yaml", yaml.safe_dump([[0, 0], [1, 0], [1, 1], [0, 1]]))
+    for argv, field in (
+        (["--max-offset", "-1"], "--max-offset"),
+        (["--max-offset", "nan"], "--max-offset"),
+        (["--max-offset", "0.01", "--max-excess", "1"], "--max-offset"),
+    ):
+        assert main(["robot", "fit", path, *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and field in err, err
+    assert main(["robot", "fit", str(square), "--max-offset", "0.1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--max-offset" in err and "3D" in err
+
+
+def test_the_cache_keys_max_offset(tmp_path, monkeypatch):
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path / "cache"))
+    path = MESHES / "l_bracket.stl"
+    first, origin = cached_cover(path, 3, max_offset=0.006)
+    assert origin == "fitted" and first.offset > 0.006 and first.note
+    again, origin = cached_cover(path, 3, max_offset=0.006)
+    assert origin == "cached" and again.offset == first.offset and again.note == first.note
+    assert [b.semi_axes.tolist() for b in again.bodies] == [
+        b.semi_axes.tolist() for b in first.bodies
+    ]
+    assert cached_cover(path, 3, max_offset=0.012)[1] == "fitted"
+    plain, origin = cached_cover(path, 3)
+    assert origin == "fitted" and math.isnan(plain.offset)

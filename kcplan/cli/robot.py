@@ -55,10 +55,9 @@ def run_fit(args: argparse.Namespace) -> int:
     def progress(line: str) -> None:
         print(f"  {line}", file=sys.stderr, flush=True)
 
-    try:
-        cover = fit_cover(solid, bodies, args.max_excess, shape, progress, args.max_offset)
-    except ValueError as err:  # a 2D outline with --max-offset
-        raise InputError(f"--max-offset: {err}") from None
+    if args.max_offset is not None and solid.dimension != 3:
+        raise InputError("--max-offset: expected a 3D part (a mesh), got a 2D outline")
+    cover = fit_cover(solid, bodies, args.max_excess, shape, progress, args.max_offset)
     volume, error = union_volume(cover.bodies, TIGHTNESS_SAMPLES)
     ratio, error95 = volume / solid.volume, 1.96 * error / solid.volume
     unit = "area" if solid.dimension == 2 else "volume"

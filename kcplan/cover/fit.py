@@ -95,6 +95,9 @@ OFFSET_TOL = 0.1
 of the attained distance, or proved to be below ``max_offset``."""
 OFFSET_SAMPLES = 300
 """Surface points per child ellipsoid when candidate cuts are ranked by their offset."""
+OFFSET_PROGRESS = 0.9
+"""A ``max_offset`` fit takes its best-ranked cut only when its children stick out at
+most this share of what their parent did (else a k-d tree's cut, :func:`_offset_cut`)."""
 OFFSET_FRACTIONS = (0.25, 0.375, 0.5, 0.625, 0.75)
 """Where cuts of a ``max_offset`` fit cross a piece, as fractions of its extent along the
 cut's normal: balanced cuts only, since a body's offset shrinks with the size of its
@@ -646,18 +649,24 @@ def _fit_offset(
 
 
 def _offset_cut(search: _Search, meter, leaf: _Leaf, shape: str) -> tuple[NDArray, float]:
-    """The candidate cut of ``leaf`` whose two children stick out least (the larger of
-    their sampled offsets, then their sum; each child's ellipsoid fitted to its full hull
-    points at the search tolerance). Candidates: :meth:`_Search.planes`, and planes across
-    the direction in which the leaf's body sticks out most, at :data:`CUT_QUANTILES`."""
-    best, best_key = None, (np.inf, np.inf)
-    _, n = meter.witness(_sound_body(leaf, shape), OFFSET_SAMPLES)
+    """The cut of ``leaf``, a piece whose body sticks out too far: among planes across the
+    direction in which it sticks out most and across its ellipsoid's axes (at
+    :data:`OFFSET_FRACTIONS` of the piece's extent), the one whose two children stick out
+    least (the larger of their sampled offsets, then their sum; each child's ellipsoid
+    fitted to its hull's corners at the search tolerance), when that is at most
+    :data:`OFFSET_PROGRESS` of the leaf's own; else the plane across the ellipsoid's
+    longest axis through the middle of the piece (a k-d tree's cut, which always makes the
+    pieces smaller: a box-like piece needs two cuts before its offset drops, and the
+    greedy choice alone then slices it into slabs that all stick out as far)."""
+    own, n = meter.witness(_sound_body(leaf, shape), OFFSET_SAMPLES)
     V = leaf.piece.boundary_points
+    axes = _directions(leaf.M)
     planes = [
         (normal, float(offset))
-        for normal in ([n] if n.any() else []) + _directions(leaf.M)
+        for normal in ([n] if n.any() else []) + axes
         for offset in _spread(V @ normal)
     ]
+    best, best_key = None, (np.inf, np.inf)
     for normal, offset in planes:
         if not _crossing(V, normal[None], np.array([offset]))[0]:
             continue  # a child without volume
@@ -678,9 +687,11 @@ def _offset_cut(search: _Search, meter, leaf: _Leaf, shape: str) -> tuple[NDArra
             key = (max(estimates), sum(estimates))
             if key < best_key:
                 best, best_key = (normal, offset), key
-    if best is None:  # pragma: no cover - a piece with volume always has a crossing plane
-        raise RuntimeError("no candidate cut splits the piece")
-    return best
+    if best is not None and best_key[0] <= OFFSET_PROGRESS * own:
+        return best
+    longest = axes[0]
+    x = V @ longest
+    return longest, 0.5 * (float(x.min()) + float(x.max()))
 
 
 def _spread(x: NDArray) -> NDArray:
