@@ -16,7 +16,7 @@ sampled estimate :func:`kcplan.cover.offset.cover_offsets` for ``--bodies`` ones
 how many bodies it has::
 
     python scripts/mbm_validity.py [--per-class 100] [--bodies 1,2] [--max-offset default]
-        [--offsets]
+        [--most K] [--offsets]
 """
 
 from __future__ import annotations
@@ -46,6 +46,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--per-class", type=int, default=100)
     parser.add_argument("--bodies", default="", help="bodies per link, comma-separated")
     parser.add_argument("--max-offset", default="", help="metres (or 'default'), comma-separated")
+    parser.add_argument(
+        "--most", type=int, default=None, help="most bodies per link of --max-offset covers"
+    )
     parser.add_argument("--offsets", action="store_true", help="also how far covers stick out")
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
@@ -57,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     (joints,) = groups
     covers = [(b, None) for b in (int(k) for k in args.bodies.split(",") if k)]
     for text in (t for t in args.max_offset.split(",") if t):
-        covers.append((None, DEFAULT_MAX_OFFSET if text == "default" else float(text)))
+        covers.append((args.most, DEFAULT_MAX_OFFSET if text == "default" else float(text)))
     if not covers:
         parser.error("expected --bodies or --max-offset")
     print("| cover | class | problems | starts valid: cover / meshes | "
@@ -69,6 +72,8 @@ def main(argv: list[str] | None = None) -> int:
         arm = load_arm(args.urdf, joints, srdf=args.srdf, bodies_per_link=bodies,
                        max_offset=max_offset, progress=_fitted)  # fmt: skip
         label = f"{bodies}" if max_offset is None else f"<= {1000 * max_offset:g} mm"
+        if max_offset is not None and bodies is not None:
+            label += f", at most {bodies}"
         arms.append((label, bodies, max_offset, arm))
         notes.append(f"{label}: {len(arm.bodies)} bodies, {len(arm.self_pairs)} self pairs, "
                      f"loaded in {time.perf_counter() - t0:.1f} s")  # fmt: skip

@@ -9,8 +9,10 @@ list of joints in state order; every other joint is locked at a fixed value
 group's joint vector (``nq`` = number of joints in the group).
 
 Every collision geometry is covered by ellipsoids: a mesh by :mod:`kcplan.cover` (its own
-triangles, a sound cover, cached per user; a mesh that is not closed, such as the Panda's
-link6, by a cover of its convex hull, which holds every triangle), a sphere exactly, a box
+triangles, a sound cover, cached per user; by default cut until it sticks out of the mesh
+by at most :data:`DEFAULT_MAX_OFFSET`, or a fixed number of bodies per link; a mesh that
+is not closed, such as the Panda's link6, by a cover of its convex hull, which holds every
+triangle), a sphere exactly, a box
 and a cylinder by the smallest ellipsoid through their corners or rims (below). A body's
 frame is given in the frame of the joint that carries it (``placement``, a 4 x 4
 homogeneous matrix: the geometry's placement in the joint frame times the body's pose in

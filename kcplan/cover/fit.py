@@ -31,6 +31,20 @@ others reached with as many leaves) and is grown from there; a ring or a pipe, w
 first greedy cut makes two flat rings, is cut into sectors this way. Every tree is a
 tree of planes whose leaves are fitted to their full hull points, so each is sound.
 
+*By how far the cover sticks out* (``max_offset``, 3D). Volume does not see a body that
+bulges a centimetre out of a flat face, and a grasp that leaves a finger 9 mm from an
+object then collides for the cover (issue 25). With ``max_offset``, the tree is grown
+from the whole part by cutting, one leaf at a time, the leaf whose body sticks out most
+(sampled, :meth:`kcplan.cover.offset.OffsetMeter.estimate`), until every body is *proved*
+to stick out by at most ``max_offset`` (:meth:`kcplan.cover.offset.OffsetMeter.bound`,
+every point of the ellipsoid, its inside included), or until ``bodies`` leaves (default
+:data:`MAX_OFFSET_BODIES`; :attr:`Cover.note` then says how many bodies still stick out
+and by how much, and :attr:`Cover.offset` is the proved bound of what was reached). The
+cut of a leaf is the candidate (see :func:`_offset_cut`) whose children stick out least
+when that is a real gain, else a k-d tree's cut across its longest axis. The leaves are
+fitted as in the volume fit (the smallest ellipsoid of the piece's hull points), so the
+cover is sound by the same proof.
+
 The cover is of the *input's own* surface and solid (no remeshing, no decomposition
 library: an approximate convex decomposition such as CoACD remeshes the input and
 simplifies its hulls, so its pieces need not cover the part).
@@ -622,7 +636,9 @@ def _fit_offset(
         if len(leaves) >= most:
             for leaf in (leaves[k] for k in over):  # the value, not just "above"
                 body = bounds[id(leaf)][0]
-                bounds[id(leaf)] = (body, meter.bound(body, tol))
+                # to a tenth of the value: a tight bound of a large offset costs minutes
+                coarse = max(tol, 0.1 * bounds[id(leaf)][1].low)
+                bounds[id(leaf)] = (body, meter.bound(body, coarse))
             worst = max(bounds[id(leaf)][1].high for leaf in leaves)
             note = (
                 f"stopped at {most} bodies, the most asked for: {len(over)} still stick out "
