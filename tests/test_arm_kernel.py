@@ -12,7 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from kcplan.arm import ArmWorld, load_arm
-from kcplan.arm.bounds import carries, point_speeds, relative_speeds
+from kcplan.arm.bounds import carries, lever_growth, levers, point_speeds, relative_speeds
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
@@ -87,6 +87,45 @@ def test_kernel_speed_bounds_are_the_python_bounds(panda, world):
     pairs = world.self_pairs
     got = np.array(chain.relative_speeds(pairs.tolist())).reshape(len(pairs), panda.dof)
     np.testing.assert_allclose(got, relative_speeds(rho, C, pairs), rtol=1e-15, atol=0)
+
+
+def test_kernel_levers_are_the_python_levers(panda, world, states):
+    chain = world.kernel.chain
+    rho = point_speeds(panda)
+    for q1, q2 in zip(states[:10], states[1:11], strict=True):
+        got = np.array(chain.levers(q1.tolist())).reshape(rho.shape)
+        np.testing.assert_allclose(got, levers(panda, q1), rtol=0, atol=1e-12)
+        assert (got <= rho + 1e-12).all() and ((got > 0) == (rho > 0)).all()
+        dq = np.abs(q2 - q1)
+        growth = np.array(chain.lever_growth(dq.tolist())).reshape(rho.shape)
+        np.testing.assert_allclose(growth, lever_growth(panda, dq), rtol=1e-14, atol=0)
+
+
+def test_the_local_bound_holds_along_random_edges(panda, states):
+    """Every covering ellipsoid's points move at most A t + Q t^2 / 2 within t of a
+    guard at s = m (kcplan.arm.bounds): checked on the ellipsoids' sampled surface points,
+    placed by the forward kinematics at s = m +- t, and the bound is below the global one
+    (v t) for short t."""
+    u = np.random.default_rng(2).normal(size=(200, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    rho = point_speeds(panda)
+    tighter = 0
+    for q1, q2 in zip(states[20:40], states[21:41], strict=True):
+        dq, m = np.abs(q2 - q1), 0.4
+        qm = q1 + m * (q2 - q1)
+        A = levers(panda, qm) @ dq
+        Q = lever_growth(panda, dq).sum(axis=1)
+        at_m = body_frames(panda, qm)
+        for t in (0.02, 0.1, 0.3, 0.6):
+            frames = body_frames(panda, q1 + (m + t) * (q2 - q1))
+            for k, body in enumerate(panda.bodies):
+                local = u * body.semi_axes
+                moved = (local @ frames[k][:3, :3].T + frames[k][:3, 3]) - (
+                    local @ at_m[k][:3, :3].T + at_m[k][:3, 3]
+                )
+                assert np.linalg.norm(moved, axis=1).max() <= A[k] * t + Q[k] * t * t / 2 + 1e-12
+            tighter += (A * 0.02 + Q * 0.0002 < rho @ dq * 0.02).sum()
+    assert tighter > 0.5 * 20 * len(panda.bodies)
 
 
 def test_kernel_and_python_agree_on_every_state(world, states):

@@ -163,6 +163,16 @@ CASES = [
         for planner in ("kc-rrtconnect", "kc-rrtconnect-py")
     ),
     Case(
+        "arm_edge_cost.py",
+        ("scenarios/arm/table_pick_1.yaml", "--seed", "1", "--time", "5"),
+        (
+            r"^table_pick_1, kc-rrtconnect, seed 1: solved in ",
+            rf"^\| certified \| [1-9]\d* \| {NUMBER} \| {NUMBER} \| \d+% \|$",
+            rf"^\| state \| [1-9]\d* \| {NUMBER} \| {NUMBER} \| \d+% \|$",
+            r"^guards per edge [\d.]+, probes per edge [\d.]+, ",
+        ),
+    ),
+    Case(
         "hrm_settings_check.py",
         ("--hrm", "{hrm}"),
         (r"\| map \| robot \|", r"\| sparse \| \w+ \| [^|]+ \| [^|]+ \| (yes|no) \|"),

@@ -24,6 +24,38 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   pair_speed_.resize(world.pairs().size());
   q_.resize(n_);
   caps_.resize(speed_.size());
+  dq_.resize(n_);
+  growth_.resize(speed_.size() * n_);
+  pair_growth_.resize(pair_speed_.size());
+  const std::vector<bool>& C = chain_.carries();
+  for (const auto& [k, l] : world.pairs())
+    for (int j = 0; j < n_; ++j) {
+      const bool ck = C[k * n_ + j], cl = C[l * n_ + j];
+      only_first_.push_back(ck && !cl), only_second_.push_back(cl && !ck);
+    }
+}
+
+double ArmCertifier::reach(double d, double v, double A, double Q) {
+  if (!(v > 0.0)) return std::numeric_limits<double>::infinity();  // it does not move
+  const double root = 2.0 * d / (A + std::sqrt(A * A + 2.0 * Q * d));  // of A t + Q t^2 / 2 = d
+  return std::max(d / v, root);
+}
+
+void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const {
+  const std::size_t bodies = speed_.size();
+  A = 0.0;
+  if (k < bodies) {
+    for (int j = 0; j < n_; ++j) A += dq_[j] * guard.levers[k * n_ + j];
+    Q = 0.0;
+    for (int j = 0; j < n_; ++j) Q += growth_[k * n_ + j];
+    return;
+  }
+  const std::size_t m = k - bodies;
+  const auto [a, b] = world_.pairs()[m];
+  for (int j = 0; j < n_; ++j)
+    A += dq_[j] * (only_first_[m * n_ + j] * guard.levers[a * n_ + j] +
+                   only_second_[m * n_ + j] * guard.levers[b * n_ + j]);
+  Q = pair_growth_[m];
 }
 
 bool ArmCertifier::reject(std::int64_t& reason) {
@@ -71,18 +103,25 @@ bool ArmCertifier::state_valid(const double* q) {
   return known == 1;
 }
 
-ArmGuard ArmCertifier::measure(const double* q, const double* caps) {
+ArmGuard ArmCertifier::measure(const double* q, double enough) {
   ++counters.guards;
   ArmGuard g;
   std::copy(q, q + n_, g.q.begin());
   const std::size_t bodies = chain_.bodies().size(), pairs = world_.pairs().size();
   g.scene.resize(bodies);
   g.pairs.resize(pairs);
-  g.scene_exact.assign(bodies, caps == nullptr);
+  g.levers.resize(bodies * n_);
+  g.scene_exact.assign(bodies, !(enough > 0.0));
   g.pair_exact.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
-  if (caps != nullptr) {
-    for (std::size_t k = 0; k < bodies; ++k) caps_[k] = std::max(caps[k], kClearanceFloor);
+  chain_.levers(world_.joint_frames(), frames, g.levers.data());
+  if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2)
+    double A, Q;
+    for (std::size_t k = 0; k < bodies; ++k) {
+      terms(g, k, A, Q);
+      const double need = std::min(enough * speed_[k], enough * (A + 0.5 * enough * Q));
+      caps_[k] = std::max(kCapSlack * need, kClearanceFloor);
+    }
     world_.scene_clearances(g.scene.data(), caps_.data());
   } else {
     world_.scene_clearances(g.scene.data());
@@ -100,12 +139,15 @@ ArmGuard ArmCertifier::measure(const double* q, const double* caps) {
   return g;
 }
 
-double ArmCertifier::radius(const ArmGuard& guard, const std::vector<double>& speed,
-                            const std::vector<double>& pair_speed, double enough) {
+double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   if (guard.clearance <= 0.0) return 0.0;
-  double r = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < speed.size(); ++k)
-    if (speed[k] > 0.0 && guard.scene_exact[k]) r = std::min(r, guard.scene[k] / speed[k]);
+  const std::size_t bodies = speed_.size();
+  double r = std::numeric_limits<double>::infinity(), A, Q;
+  for (std::size_t k = 0; k < bodies; ++k)
+    if (speed_[k] > 0.0 && guard.scene_exact[k]) {
+      terms(guard, k, A, Q);
+      r = std::min(r, reach(guard.scene[k], speed_[k], A, Q));
+    }
   bool placed = false;
   const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
     if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
@@ -113,26 +155,31 @@ double ArmCertifier::radius(const ArmGuard& guard, const std::vector<double>& sp
   };
   // a bound that would hold r below what is needed is refined first: the radius is then
   // that of exact distances, or at least `enough`
-  for (std::size_t k = 0; k < speed.size(); ++k) {
-    const double v = speed[k];
-    if (!(v > 0.0) || guard.scene_exact[k]) continue;
-    if (guard.scene[k] < std::min(r, enough) * v) {
+  for (std::size_t k = 0; k < bodies; ++k) {
+    if (!(speed_[k] > 0.0) || guard.scene_exact[k]) continue;
+    terms(guard, k, A, Q);
+    double t = reach(guard.scene[k], speed_[k], A, Q);
+    if (t < std::min(r, enough)) {
       const double cap = std::numeric_limits<double>::infinity();
       guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
       guard.scene_exact[k] = 1;
       ++refined_bodies;
+      t = reach(guard.scene[k], speed_[k], A, Q);
     }
-    r = std::min(r, guard.scene[k] / v);
+    r = std::min(r, t);
   }
-  for (std::size_t m = 0; m < pair_speed.size(); ++m) {
-    const double v = pair_speed[m];
+  for (std::size_t m = 0; m < pair_speed_.size(); ++m) {
+    const double v = pair_speed_[m];
     if (!(v > 0.0)) continue;
-    if (!guard.pair_exact[m] && guard.pairs[m] < std::min(r, enough) * v) {
+    terms(guard, bodies + m, A, Q);
+    double t = reach(guard.pairs[m], v, A, Q);
+    if (!guard.pair_exact[m] && t < std::min(r, enough)) {
       guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
       guard.pair_exact[m] = 1;
       ++refined_pairs;
+      t = reach(guard.pairs[m], v, A, Q);
     }
-    r = std::min(r, guard.pairs[m] / v);
+    r = std::min(r, t);
   }
   return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
 }
@@ -144,9 +191,7 @@ std::shared_ptr<const ArmGuard> ArmCertifier::endpoint(const double* q,
     return g;
   }
   ++counters.endpoint_guards;
-  // as much as this edge needs: its whole length (s in [0, 1]) from this end
-  for (std::size_t k = 0; k < speed_.size(); ++k) caps_[k] = kCapSlack * speed_[k];
-  return cache_.add_guard(key, measure(q, caps_.data()));
+  return cache_.add_guard(key, measure(q, 1.0));  // this edge's whole length from this end
 }
 
 bool ArmCertifier::check(const double* q1, const double* q2) {
@@ -155,27 +200,36 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
   if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
   if (!state_valid(q2)) return reject(c.rejected_end_state);
   const std::size_t dof = n_;
-  for (std::size_t j = 0; j < dof; ++j) q_[j] = std::abs(q2[j] - q1[j]);
+  for (std::size_t j = 0; j < dof; ++j) dq_[j] = std::abs(q2[j] - q1[j]);
   for (std::size_t k = 0; k < speed_.size(); ++k) {
     double v = 0.0;
-    for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * q_[j];
+    for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * dq_[j];
     speed_[k] = v;
   }
   for (std::size_t m = 0; m < pair_speed_.size(); ++m) {
     double v = 0.0;
-    for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * q_[j];
+    for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * dq_[j];
     pair_speed_[m] = v;
+  }
+  chain_.lever_growth(dq_.data(), growth_.data());
+  for (std::size_t m = 0; m < pair_growth_.size(); ++m) {
+    const auto [a, b] = world_.pairs()[m];
+    double Q = 0.0;
+    for (std::size_t j = 0; j < dof; ++j)
+      Q += only_first_[m * dof + j] * growth_[a * dof + j] +
+           only_second_[m * dof + j] * growth_[b * dof + j];
+    pair_growth_[m] = Q;
   }
   const ArmGuardCache::Key k1 = ArmGuardCache::key_of(q1, n_), k2 = ArmGuardCache::key_of(q2, n_);
   std::shared_ptr<const ArmGuard> g1 = cache_.guard(k1), g2 = cache_.guard(k2);
   double lo = 0.0, hi = 1.0;
   if (g1) {
     ++c.cached_guards;
-    lo = radius(*g1, speed_, pair_speed_, 1.0);
+    lo = radius(*g1, 1.0);
   }
   if (g2 && lo < 1.0) {
     ++c.cached_guards;
-    hi = 1.0 - radius(*g2, speed_, pair_speed_, 1.0 - lo);
+    hi = 1.0 - radius(*g2, 1.0 - lo);
   }
   if (lo >= hi) return certified_by_endpoints();
   if (probes_) {
@@ -184,11 +238,11 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     if (!probe(q1, q2, lo, hi, std::sqrt(length))) return reject(c.rejected_probe);
   }
   if (!g1) {
-    lo = radius(*endpoint(q1, k1), speed_, pair_speed_, 1.0);
+    lo = radius(*endpoint(q1, k1), 1.0);
     if (lo <= 0.0) return reject(c.rejected_guard);
   }
   if (!g2 && lo < hi) {
-    hi = 1.0 - radius(*endpoint(q2, k2), speed_, pair_speed_, 1.0 - lo);
+    hi = 1.0 - radius(*endpoint(q2, k2), 1.0 - lo);
     if (hi >= 1.0) return reject(c.rejected_end_state);
   }
   if (lo >= hi) return certified_by_endpoints();
@@ -199,9 +253,7 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
       [&](double m, double s0, double s1, double& g_lo, double& g_hi) {
         for (int j = 0; j < n_; ++j) q[j] = q1[j] + m * (q2[j] - q1[j]);
         const double enough = 0.5 * (s1 - s0);  // this guard covers [s0, s1] with that
-        std::vector<double>& caps = caps_;
-        for (std::size_t k = 0; k < speed_.size(); ++k) caps[k] = kCapSlack * enough * speed_[k];
-        const double r = radius(measure(q.data(), caps.data()), speed_, pair_speed_, enough);
+        const double r = radius(measure(q.data(), enough), enough);
         if (r <= 0.0) return false;
         g_lo = m - r, g_hi = m + r;
         return true;

@@ -25,6 +25,7 @@ namespace kcplan {
 /// it wrong, so a cached guard is refined in place when another edge needs more of it.
 struct ArmGuard {
   std::array<double, Chain::kMaxJoints> q{};
+  std::vector<double> levers;  ///< Chain::levers at q: bodies x dof
   mutable std::vector<double> scene, pairs;
   mutable std::vector<char> scene_exact, pair_exact;
   double clearance = 0.0;  ///< > 0: the state is free (the smallest bound, once exact)
@@ -45,10 +46,13 @@ struct ArmCertifierOptions {
 /// For the straight edge q(s) = q1 + s (q2 - q1), no point of body k moves faster than
 /// v_k = sum_j rho[k, j] |dq_j| per unit of s and no two points of a self pair (k, l)
 /// approach faster than v_kl (Chain::point_speeds, Chain::relative_speeds; Schwarzer, Saha
-/// and Latombe 2005). A guard at s = m with clearances d_k and d_kl therefore proves the
-/// open stretch |s - m| < r, r = min(min_k d_k / v_k, min_kl d_kl / v_kl), free: each
-/// body stays clear of the scene and of each body it may collide with, and the covers
-/// hold the links. kcplan/planning/arm_certifier.py has the proof in full.
+/// and Latombe 2005); nor, within t of a guard at s = m, farther than A t + Q t^2 / 2,
+/// with A from the levers at q(m) and Q from how fast they can grow (Chain::levers,
+/// Chain::lever_growth). A guard with clearances d_k and d_kl therefore proves the open
+/// stretch |s - m| < r free, r the smallest over bodies and pairs of
+/// max(d / v, the root t of A t + Q t^2 / 2 = d): each body stays clear of the scene and
+/// of each body it may collide with, and the covers hold the links.
+/// kcplan/planning/arm_certifier.py has the proof in full.
 ///
 /// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
 /// outside the limits or not finite rejects the edge with no query; (2) q2's validity
@@ -70,14 +74,15 @@ class ArmCertifier {
   bool check(const double* q1, const double* q2);
   /// State validity with the cache: one collision query for a state not seen before.
   bool state_valid(const double* q);
-  /// One guard at q, not cached; body k's clearance is measured up to caps[k] (null:
-  /// wholly), and never below kClearanceFloor, so that clearance > 0 still means free.
-  ArmGuard measure(const double* q, const double* caps = nullptr);
-  /// The half width, in s, of a stretch `guard` proves free for the speeds: the
-  /// clearance ball's radius min(d_k / v_k, d_kl / v_kl), or a radius of at least
-  /// `enough` (the guard's bounds are refined where they would limit it below that).
-  double radius(const ArmGuard& guard, const std::vector<double>& speed,
-                const std::vector<double>& pair_speed, double enough);
+  /// One guard at q, not cached. With `enough` > 0 (during check()), each body's
+  /// clearance is measured only as far as a radius of `enough` needs for the current
+  /// edge, and never below kClearanceFloor, so that clearance > 0 still means free;
+  /// otherwise wholly.
+  ArmGuard measure(const double* q, double enough = -1.0);
+  /// The half width, in s, of a stretch `guard` proves free for the current edge (the
+  /// class docs), or a radius of at least `enough` (the guard's bounds are refined where
+  /// they would limit it below that).
+  double radius(const ArmGuard& guard, double enough);
 
   /// The smallest cap of a body's clearance (metres): a body closer than this to an
   /// obstacle is always measured.
@@ -110,8 +115,15 @@ class ArmCertifier {
   int n_, max_guards_;
   bool probes_;
   ArmGuardCache cache_;
+  /// The radius a clearance d gives to a body or pair of global speed v, lever term A
+  /// and growth Q (the class docs).
+  static double reach(double d, double v, double A, double Q);
+  /// A and Q of body k (k < bodies) or of pair k - bodies, for the current edge.
+  void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
+
   std::vector<double> rho_, rho_pairs_;
-  std::vector<double> speed_, pair_speed_, q_, caps_;
+  std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
+  std::vector<double> speed_, pair_speed_, q_, caps_, dq_, growth_, pair_growth_;
   std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
   std::vector<std::pair<double, double>> pending_;
 };

@@ -49,6 +49,8 @@ class ArmWorld {
   /// Place the bodies at q (no query) and return their frames; valid until the next
   /// place().
   const std::vector<coal::Transform3s>& place(const double* q);
+  /// The joints' frames of the last place().
+  const std::vector<coal::Transform3s>& joint_frames() const { return joints_; }
   /// Certain clearance of each body to the obstacles, as placed (one distance query);
   /// with `caps`, min(clearance, caps[k]) (World::bodies_safe_clearances).
   void scene_clearances(double* out, const double* caps = nullptr) {

@@ -284,6 +284,18 @@ NB_MODULE(_core, m) {
         c.joint_frames(joints_of(c, q), frames);
         return frames_of(frames);
       }, "q"_a)
+      .def("levers", [](const kcplan::Chain& c, const std::vector<double>& q) {
+        std::vector<coal::Transform3s> joints, frames;
+        c.body_frames(joints_of(c, q), joints, frames);
+        std::vector<double> out(c.bodies().size() * c.dof());
+        c.levers(joints, frames, out.data());
+        return out;
+      }, "q"_a)
+      .def("lever_growth", [](const kcplan::Chain& c, const std::vector<double>& dq) {
+        std::vector<double> out(c.bodies().size() * c.dof());
+        c.lever_growth(joints_of(c, dq), out.data());
+        return out;
+      }, "dq"_a)
       .def("body_frames", [](const kcplan::Chain& c, const std::vector<double>& q) {
         std::vector<coal::Transform3s> joints, frames;
         c.body_frames(joints_of(c, q), joints, frames);

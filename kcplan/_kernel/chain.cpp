@@ -124,6 +124,34 @@ void Chain::body_frames(const double* q, std::vector<coal::Transform3s>& joints,
     out[k] = joints[bodies_[k].joint] * bodies_[k].placement;
 }
 
+void Chain::levers(const std::vector<coal::Transform3s>& joints,
+                   const std::vector<coal::Transform3s>& bodies, double* out) const {
+  const std::size_t dof = lower_.size();
+  std::fill(out, out + bodies_.size() * dof, 0.0);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const coal::Vec3s& c = bodies[k].getTranslation();
+    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {
+      const ChainJoint& joint = joints_[i - 1];
+      out[k * dof + joint.state] =
+          joint.prismatic ? 1.0 : (c - joints[i].getTranslation()).norm() + bodies_[k].a_max;
+    }
+  }
+}
+
+void Chain::lever_growth(const double* dq, double* out) const {
+  const std::size_t dof = lower_.size();
+  std::fill(out, out + bodies_.size() * dof, 0.0);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    double below = 0.0;  // sum of |dq_i| rho[k, i] over the joints walked so far
+    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {
+      const ChainJoint& joint = joints_[i - 1];
+      const double step = std::abs(dq[joint.state]);
+      if (!joint.prismatic) out[k * dof + joint.state] = step * below;
+      below += step * rho_[k * dof + joint.state];
+    }
+  }
+}
+
 std::vector<double> Chain::relative_speeds(const std::vector<std::array<int, 2>>& pairs) const {
   const std::size_t dof = lower_.size();
   std::vector<double> out(pairs.size() * dof, 0.0);

@@ -77,6 +77,17 @@ class Chain {
   const std::vector<double>& point_speeds() const { return rho_; }
   /// Whether joint j (state order) carries body k: carries()[k * dof + j].
   const std::vector<bool>& carries() const { return carries_; }
+  /// The levers at a configuration: out[k * dof + j] = |c_k - o_j| + a_max,k, the
+  /// farthest any point of body k lies from joint j's origin (c_k its centre, o_j the
+  /// joint's origin, both at the frames given: joint_frames and body_frames of one q),
+  /// 1 for a prismatic joint, 0 where j does not carry k. Never above point_speeds().
+  void levers(const std::vector<coal::Transform3s>& joints,
+              const std::vector<coal::Transform3s>& bodies, double* out) const;
+  /// How fast the levers can grow along an edge with joint steps |dq| = `dq`:
+  /// out[k * dof + j] = |dq_j| sum_i |dq_i| rho[k, i] over the joints i below j that
+  /// carry k (they alone change |x - o_j|), 0 for a prismatic j or one not carrying k
+  /// (kcplan/arm/bounds.py lever_growth).
+  void lever_growth(const double* dq, double* out) const;
   /// The bound on how fast the distance between a point of body k and a point of body l
   /// changes per unit of joint j's motion: only the joints that carry exactly one of
   /// them count (kcplan/arm/bounds.py relative_speeds). Row m for pairs[m], dof per row.

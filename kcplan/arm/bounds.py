@@ -35,8 +35,20 @@ between any point of body ``k`` and any point of body ``l`` changes at most at t
 
     sum_{j carries k only} |dq_j| rho[k, j] + sum_{j carries l only} |dq_j| rho[l, j].
 
-These are the bounds of the clearance-ball certificate for arms (a body whose clearance
-at ``q(m)`` exceeds its speed bound times ``|s - m|`` stays free on that stretch).
+*Local* bounds at a guard. At the configuration ``q(m)`` the farthest point of body ``k``
+from joint ``j``'s origin is ``lever[k, j] = |c_k - o_j| + a_max,k`` (centre and origin at
+``q(m)``; :func:`levers`), usually far below ``rho[k, j]``. Along the edge that distance
+changes only through the joints ``i`` below ``j`` that carry ``k`` (the joints above ``j``,
+and ``j`` itself, move ``x`` and ``o_j`` rigidly together or turn ``x`` about an axis
+through ``o_j``), each at most at ``|dq_i| rho[k, i]``. So within ``t`` of ``m``
+
+    |x(s) - x(m)| <= t A_k + t^2 Q_k / 2,   A_k = sum_j |dq_j| lever[k, j],
+                                             Q_k = sum_j |dq_j| sum_(i below j) |dq_i| rho[k, i]
+
+(:func:`lever_growth` gives the terms of ``Q_k``; a prismatic joint's lever is 1 and does
+not grow). A self pair's terms sum those of the joints that carry one body only, as for
+its speed. These are the bounds of the clearance-ball certificate for arms: a body whose
+clearance ``d`` at ``q(m)`` exceeds ``min(v t, A t + Q t^2 / 2)`` stays free within ``t``.
 """
 
 from __future__ import annotations
@@ -46,10 +58,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.kinematics import body_frames, joint_frames
 from kcplan.arm.model import ArmModel
 
 __all__ = [
     "carries",
+    "lever_growth",
+    "levers",
     "chain_speeds",
     "pair_speeds",
     "point_speeds",
@@ -138,3 +153,43 @@ def pair_speeds(
     of ``s``."""
     dq = np.abs(np.asarray(q2, dtype=float) - np.asarray(q1, dtype=float))
     return relative_speeds(point_speeds(arm), carries(arm), pairs) @ dq
+
+
+def levers(arm: ArmModel, state: Sequence[float]) -> NDArray[np.float64]:
+    """``lever[k, j]``: the farthest any point of body ``k`` lies from joint ``j``'s origin
+    at ``state`` (``|c_k - o_j| + a_max,k``; 1 for a prismatic joint; 0 where ``j`` does not
+    carry ``k``), shape ``(len(arm.bodies), arm.dof)``; never above :func:`point_speeds`."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    joints, bodies = joint_frames(arm, state), body_frames(arm, state)
+    out = np.zeros((len(arm.bodies), arm.dof))
+    for k, body in enumerate(arm.bodies):
+        i = body.joint
+        while i > 0:
+            j = state_of[i]
+            if arm.kinds[j] == "prismatic":
+                out[k, j] = 1.0
+            else:
+                centre, origin = bodies[k][:3, 3], joints[i][:3, 3]
+                out[k, j] = np.linalg.norm(centre - origin) + body.semi_axes.max()
+            i = int(model.parents[i])
+    return out
+
+
+def lever_growth(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:
+    """``G[k, j] = |dq_j| sum_i |dq_i| rho[k, i]`` over the joints ``i`` below ``j`` that
+    carry body ``k``: the rate at which ``|dq_j| lever[k, j]`` can grow per unit of ``s``
+    (module docstring; 0 for a prismatic ``j``), shape ``(len(arm.bodies), arm.dof)``."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    rho, step = point_speeds(arm), np.abs(np.asarray(dq, dtype=float))
+    out = np.zeros((len(arm.bodies), arm.dof))
+    for k, body in enumerate(arm.bodies):
+        below, i = 0.0, body.joint
+        while i > 0:
+            j = state_of[i]
+            if arm.kinds[j] != "prismatic":
+                out[k, j] = step[j] * below
+            below += step[j] * rho[k, j]
+            i = int(model.parents[i])
+    return out

@@ -5,9 +5,13 @@ covering body ``k``, its certain clearance ``d_k`` to the obstacles and, for eac
 pair ``(k, l)``, their certain distance ``d_kl`` (:meth:`kcplan.arm.ArmWorld.
 safe_clearances`). Along the edge no point of body ``k`` moves faster than ``v_k`` per unit
 of ``s``, and no two points of ``k`` and ``l`` approach faster than ``v_kl``
-(:mod:`kcplan.arm.bounds`, Schwarzer, Saha and Latombe 2005). So for ``|s - m| < r`` with
+(:mod:`kcplan.arm.bounds`, Schwarzer, Saha and Latombe 2005); nor, within ``t`` of ``m``,
+farther than ``A t + Q t^2 / 2``, with ``A`` from the levers at ``q(m)`` (the farthest
+points from each joint's origin there) and ``Q`` from how fast they can grow along the
+edge (:func:`kcplan.arm.bounds.levers`, :func:`kcplan.arm.bounds.lever_growth`; a pair
+takes the joints that carry one of its bodies only). So for ``|s - m| < r`` with
 
-    r = min( min_k d_k / v_k , min_(k,l) d_kl / v_kl )
+    r = min over bodies and pairs of max( d / v , t ),  A t + Q t^2 / 2 = d
 
 every body stays clear of every obstacle (it was ``d_k`` away and moved less than
 ``d_k``) and of every body it may collide with: the stretch ``(m - r, m + r)`` is free.
@@ -34,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kcplan.arm.bounds import carries, point_speeds, relative_speeds
+from kcplan.arm.bounds import carries, lever_growth, levers, point_speeds, relative_speeds
 from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
 from kcplan.planning.guard import GuardCache
 
@@ -60,10 +64,12 @@ MAX_PROBES = 64
 @dataclass(frozen=True, eq=False)
 class ArmGuard:
     """One guard of an arm: the certain clearance of each body to the scene
-    ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres."""
+    ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres, and the levers at
+    its state (:func:`kcplan.arm.bounds.levers`, ``(bodies, dof)``)."""
 
     scene: np.ndarray
     pairs: np.ndarray
+    levers: np.ndarray
 
     @property
     def clearance(self) -> float:
@@ -107,7 +113,10 @@ class ArmEdgeCertifier:
         self.n = self.arm.dof
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
-        self._rho_pairs = relative_speeds(self._rho, carries(self.arm), world.self_pairs)
+        C, pairs = carries(self.arm), world.self_pairs
+        self._rho_pairs = relative_speeds(self._rho, C, pairs)
+        # joints that carry the first (second) body of a pair only
+        self._only = (C[pairs[:, 0]] & ~C[pairs[:, 1]], C[pairs[:, 1]] & ~C[pairs[:, 0]])
         self.cache = GuardCache(cache_entries)
         self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
         self.covered = {"ball": 0.0}
@@ -131,7 +140,7 @@ class ArmEdgeCertifier:
 
     def _measure(self, q: np.ndarray) -> ArmGuard:
         self.counters["guards"] += 1
-        return ArmGuard(*self.world.safe_clearances(q))
+        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q))
 
     def _endpoint(self, q: np.ndarray) -> ArmGuard:
         key = q.tobytes()
@@ -144,17 +153,29 @@ class ArmEdgeCertifier:
             self.counters["cached_guards"] += 1
         return guard
 
-    def _radius(self, guard: ArmGuard, speed: np.ndarray, pair_speed: np.ndarray) -> float:
+    def _terms(self, q1: np.ndarray, q2: np.ndarray) -> tuple:
+        """What a guard's radius needs of the edge: the global speeds of the bodies and
+        pairs, ``|dq|``, and the growth terms ``Q`` of bodies and pairs (module docs)."""
+        dq = np.abs(q2 - q1)
+        growth = lever_growth(self.arm, dq)
+        first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
+        only_first, only_second = self._only
+        pair_growth = (growth[first] * only_first + growth[second] * only_second).sum(axis=1)
+        return self._rho @ dq, self._rho_pairs @ dq, dq, growth.sum(axis=1), pair_growth
+
+    def _radius(self, guard: ArmGuard, terms: tuple) -> float:
         """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
-        scene, pairs = guard.scene, guard.pairs
         if guard.clearance <= 0.0:
             return 0.0
-        r = math.inf
-        with np.errstate(divide="ignore"):
-            if len(scene):
-                r = min(r, float(np.min(np.where(speed > 0, scene / speed, math.inf))))
-            if len(pairs):
-                r = min(r, float(np.min(np.where(pair_speed > 0, pairs / pair_speed, math.inf))))
+        speed, pair_speed, dq, growth, pair_growth = terms
+        first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
+        only_first, only_second = self._only
+        L = guard.levers
+        pair_levers = L[first] * only_first + L[second] * only_second
+        r = min(
+            _reach(guard.scene, speed, L @ dq, growth),
+            _reach(guard.pairs, pair_speed, pair_levers @ dq, pair_growth),
+        )
         return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
 
     def _reject(self, reason: str) -> bool:
@@ -173,32 +194,30 @@ class ArmEdgeCertifier:
             return self._reject("rejected_end_state")
         if not self.state_valid(q2):
             return self._reject("rejected_end_state")
-        dq = np.abs(q2 - q1)
-        speed = self._rho @ dq
-        pair_speed = self._rho_pairs @ dq
+        terms = self._terms(q1, q2)
         g1, g2 = self.cache.guard(q1.tobytes()), self.cache.guard(q2.tobytes())
         lo, hi = 0.0, 1.0
         if g1 is not None:
             c["cached_guards"] += 1
-            lo = self._radius(g1, speed, pair_speed)
+            lo = self._radius(g1, terms)
         if g2 is not None and lo < 1.0:
             c["cached_guards"] += 1
-            hi = 1.0 - self._radius(g2, speed, pair_speed)
+            hi = 1.0 - self._radius(g2, terms)
         if lo >= hi:
             return self._certified_by_endpoints()
         if self.probes and not self._probe(q1, q2, lo, hi, _length(q2 - q1)):
             return self._reject("rejected_probe")
         if g1 is None:
-            lo = self._radius(self._endpoint(q1), speed, pair_speed)
+            lo = self._radius(self._endpoint(q1), terms)
             if lo <= 0.0:
                 return self._reject("rejected_guard")
         if g2 is None and lo < hi:
-            hi = 1.0 - self._radius(self._endpoint(q2), speed, pair_speed)
+            hi = 1.0 - self._radius(self._endpoint(q2), terms)
             if hi >= 1.0:
                 return self._reject("rejected_end_state")
         if lo >= hi:
             return self._certified_by_endpoints()
-        return self._advance(q1, q2, lo, hi, speed, pair_speed)
+        return self._advance(q1, q2, lo, hi, terms)
 
     def _certified_by_endpoints(self) -> bool:
         self.counters["certified_by_endpoints"] += 1
@@ -218,9 +237,9 @@ class ArmEdgeCertifier:
                 return False
         return True
 
-    def _advance(self, q1, q2, lo, hi, speed, pair_speed) -> bool:
+    def _advance(self, q1, q2, lo, hi, terms) -> bool:
         def reach(m: float, s0: float, s1: float) -> tuple[float, float] | None:
-            r = self._radius(self._measure(q1 + m * (q2 - q1)), speed, pair_speed)
+            r = self._radius(self._measure(q1 + m * (q2 - q1)), terms)
             return None if r <= 0.0 else (m - r, m + r)
 
         reason, guards = advance(lo, hi, self.max_guards, reach)
@@ -235,3 +254,15 @@ class ArmEdgeCertifier:
 def _length(dq: np.ndarray) -> float:
     """``|dq|`` summed in order, as the kernel sums it (the probe count is its floor)."""
     return math.sqrt(sum(float(d) * float(d) for d in dq))
+
+
+def _reach(d: np.ndarray, v: np.ndarray, A: np.ndarray, Q: np.ndarray) -> float:
+    """The smallest radius clearances ``d`` give to parts of global speed ``v``, lever term
+    ``A`` and growth ``Q``: ``max(d / v, t)`` with ``A t + Q t^2 / 2 = d`` (module docs;
+    ``inf`` for parts that do not move, and for none)."""
+    moving = v > 0
+    if not moving.any():
+        return math.inf
+    d, v, A, Q = d[moving], v[moving], A[moving], Q[moving]
+    root = 2.0 * d / (A + np.sqrt(A * A + 2.0 * Q * d))  # the stable form of the root
+    return float(np.maximum(d / v, root).min())

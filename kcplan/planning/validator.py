@@ -169,15 +169,17 @@ class KCMotionValidator(ob.MotionValidator):
         max_guards = 256 if max_guards is None else max_guards
         if backend == "kernel":
             self.certifier = KernelArmCertifier(world, max_guards, probes=probes > 0)
-            compiled, n = self.certifier.compiled, arm.dof
-            # the hot path: one call into the kernel with the two joint vectors
-            self.state_valid = lambda s: compiled.state_valid([s[j] for j in range(n)])
+            # the hot path: one call into the kernel with the joint vector(s)
+            self.state_valid = self._valid_kernel_arm
             self.checkMotion = self._check_kernel_arm
         else:
             self.certifier = ArmEdgeCertifier(world, max_guards, probes=probes > 0)
         self.backend = backend
         self.n = arm.dof
         self._read = lambda state, n=arm.dof: joint_state(state, n)
+
+    def _valid_kernel_arm(self, state) -> bool:
+        return self.certifier.compiled.state_valid([state[j] for j in range(self.n)])
 
     def _check_kernel_arm(self, s1, s2) -> bool:
         try:
