@@ -22,6 +22,7 @@ from kcplan.arm.verify import verify_arm_path
 from kcplan.arm.world import ArmWorld
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import (
+    ARM_RANGE,
     CERTIFIABLE,
     JOINT_STEP,
     PLANNER_NAMES,
@@ -188,6 +189,16 @@ for _name, _make, _what in (("rrtconnect", og.RRTConnect, "RRT-Connect"), ("prm"
         "of joint-space distance (the L2 norm of the joint difference), like VAMP's",
         joint_step=JOINT_STEP,
     )
+PLANNERS["rrtconnect-near"] = replace(
+    PLANNERS["rrtconnect"],
+    description="stock RRT-Connect, arms only: the kc planners' range on arms (ARM_RANGE)",
+    range_factor=ARM_RANGE,
+)
+PLANNERS["rrtconnect-32-near"] = replace(
+    PLANNERS["rrtconnect-32"],
+    description="rrtconnect-32 with the kc planners' range on arms (ARM_RANGE)",
+    range_factor=ARM_RANGE,
+)
 PLANNERS["rrtconnect-pin"] = PlannerSpec(
     og.RRTConnect,
     description="stock RRT-Connect, arms only: a Python isValid calling Pinocchio's "
@@ -376,8 +387,11 @@ def plan(
     planner_object = spec.make(si)
     ss.setPlanner(planner_object)
     ss.setup()
-    if spec.range_factor is not None:
-        planner_object.setRange(spec.range_factor * space.getMaximumExtent())
+    range_factor = spec.range_factor
+    if range_factor is None and spec.kc and setup.joints is not None:
+        range_factor = ARM_RANGE  # an arm's certified edges: shorter pays (ARM_RANGE)
+    if range_factor is not None and hasattr(planner_object, "setRange"):
+        planner_object.setRange(range_factor * space.getMaximumExtent())
     if spec.neighbors is not None:
         planner_object.setMaxNearestNeighbors(spec.neighbors)
     objective = ss.getProblemDefinition().getOptimizationObjective()
