@@ -60,7 +60,7 @@ from kcplan.cover.solid import Solid
 from kcplan.geometry.robot import Body
 from kcplan.geometry.winding import winding_numbers
 
-__all__ = ["OffsetMeter", "cover_offsets", "offset_bound"]
+__all__ = ["OffsetBound", "OffsetMeter", "cover_offsets", "offset_bound"]
 
 _PAIRS = 2**20
 """Point-triangle pairs measured at once (bounds the temporary arrays)."""
