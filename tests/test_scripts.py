@@ -134,6 +134,17 @@ CASES = [
         ),
     ),
     Case(
+        "arm_soundness.py",
+        ("--edges", "14", "--per-class", "1", "--bodies", "1", "--twin", "4")
+        + ("--free-check", "1"),
+        (
+            r"^\| robot \| backend \| edges \| accepted \| violations \| rejected: end state ",
+            r"^\| panda \| kernel \| 14 \| \d+ \| 0 \| \d+ / \d+ / \d+ / \d+ \| ",
+            r"^\| panda \| python \| 4 \| \d+ \| 0 \| ",
+            rf"mesh verification {NUMBER} ms per edge",
+        ),
+    ),
+    Case(
         "edge_outcomes.py",
         (CORRIDOR, "kc-rrtconnect", "1,2", "--probes", "1", "--time", "5"),
         (
