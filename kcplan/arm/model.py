@@ -264,9 +264,16 @@ def load_arm(
         if name in group:
             raise ArmError(f"{source}: fixed: {name!r} is in the planning group")
         joint = full.joints[full.getJointId(name)]
-        if joint.nq != 1 or not math.isfinite(float(value)):
-            raise ArmError(f"{source}: fixed.{name}: expected a finite value of a 1-DOF joint")
-        q_fixed[joint.idx_q] = float(value)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            value = math.nan  # not a number: refused below, as a non-finite one
+        if joint.nq != 1 or not math.isfinite(value):
+            raise ArmError(
+                f"{source}: fixed.{name}: expected a finite value of a 1-DOF joint, "
+                f"got {fixed[name]!r}"
+            )
+        q_fixed[joint.idx_q] = value
     for name in full.names[1:]:
         joint = full.joints[full.getJointId(name)]
         if name not in group and name not in fixed and joint.nq == 1:
