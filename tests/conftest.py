@@ -23,3 +23,26 @@ def semi_axes(draw, n: int, max_ratio: float = 5.0) -> np.ndarray:
 
 
 inflations = st.floats(0.005, 1.0)
+
+
+ARM_SCENE = [  # a shelf board in front of the Panda, the floor, a ball beside it
+    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},
+    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},
+    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
+]
+"""The arm tests' scene (kcplan scenario obstacle specs, 3D)."""
+
+
+def arm_obstacles(specs=ARM_SCENE):
+    """Obstacles of a 3D scene from scenario obstacle specs (read by the rigid scenario
+    loader, whose robot and bounds are placeholders)."""
+    from kcplan.world import parse_scenario
+
+    data = {
+        "name": "scene", "dimension": 3,
+        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
+        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
+        "start": {"position": [0.0, 0.0, 0.0]}, "goal": {"position": [0.0, 0.0, 0.0]},
+        "obstacles": specs,
+    }  # fmt: skip
+    return parse_scenario(data, check=False).obstacles

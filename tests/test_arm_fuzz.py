@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import arm_obstacles
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
@@ -22,17 +23,11 @@ from kcplan.arm.scenario import parse_arm_scenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world import parse_scenario
 from kcplan.world.scenario import ScenarioError
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "scenarios" / "arm" / "panda"
 GROUP = [f"panda_joint{i}" for i in range(1, 8)]
-SCENE = [  # a shelf in front of the arm, the floor, a ball beside it
-    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},
-    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},
-    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
-]
 MARGINS = [1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e100, 1e308]
 """How far outside a joint limit a fuzzed value lies (tiny to huge)."""
 FUZZ = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -47,14 +42,7 @@ def panda(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def world(panda):
-    data = {
-        "name": "scene", "dimension": 3,
-        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
-        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
-        "start": {"position": [0.0, 0.0, 0.0]}, "goal": {"position": [0.0, 0.0, 0.0]},
-        "obstacles": SCENE,
-    }  # fmt: skip
-    return ArmWorld(panda, parse_scenario(data, check=False).obstacles)
+    return ArmWorld(panda, arm_obstacles())
 
 
 @pytest.fixture(scope="module")

@@ -9,6 +9,7 @@ import fcl
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import arm_obstacles
 from scipy.spatial.transform import Rotation
 
 from kcplan.arm import ArmWorld, load_arm
@@ -17,35 +18,20 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world import parse_scenario
 from kcplan.world.scenario import Obstacle
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "scenarios" / "arm" / "panda"
 GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 
-SCENE = [
-    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},
-    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},
-    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
-]
 CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
     "cylinder", 3, {}, np.array([0.45, 0.35, 0.4]),
     Rotation.from_quat([0.3, 0.0, 0.0, 0.954]).as_matrix(), np.array([0.05, 0.05, 0.15]),
 )  # fmt: skip
 
 
-def _obstacles(specs):
-    data = {
-        "name": "scene",
-        "dimension": 3,
-        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
-        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
-        "start": {"position": [0.0, 0.0, 0.0]},
-        "goal": {"position": [0.0, 0.0, 0.0]},
-        "obstacles": specs,
-    }
-    return (*parse_scenario(data, check=False).obstacles, CYLINDER)
+def _obstacles():
+    return (*arm_obstacles(), CYLINDER)
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +43,7 @@ def panda(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def world(panda):
-    return ArmWorld(panda, _obstacles(SCENE))
+    return ArmWorld(panda, _obstacles())
 
 
 @pytest.fixture(scope="module")

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import arm_obstacles
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -15,32 +16,11 @@ from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
 from kcplan.planning.states import joint_space, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
-from kcplan.world import parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "scenarios" / "arm" / "panda"
 GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
-
-
-def _obstacles(specs):
-    data = {
-        "name": "scene",
-        "dimension": 3,
-        "bounds": {"low": [-2.0, -2.0, -2.0], "high": [2.0, 2.0, 2.0]},
-        "robot": {"semi_axes": [0.1, 0.1, 0.1]},
-        "start": {"position": [0.0, 0.0, 0.0]},
-        "goal": {"position": [0.0, 0.0, 0.0]},
-        "obstacles": specs,
-    }
-    return parse_scenario(data, check=False).obstacles
-
-
-SCENE = [
-    {"box": {"center": [0.55, 0.0, 0.25], "size": [0.3, 0.6, 0.04]}},  # a shelf board
-    {"box": {"center": [0.0, 0.0, -0.16], "size": [2.0, 2.0, 0.02]}},  # the floor
-    {"sphere": {"center": [0.3, -0.45, 0.6], "radius": 0.08}},
-]
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +32,7 @@ def panda(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def scene(panda):
-    return ArmWorld(panda, _obstacles(SCENE)), _obstacles(SCENE)
+    return ArmWorld(panda, arm_obstacles()), arm_obstacles()
 
 
 def test_the_arm_counters_are_the_rigid_certifiers():
