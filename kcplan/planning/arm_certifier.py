@@ -122,12 +122,19 @@ class ArmEdgeCertifier:
         self.covered = {"ball": 0.0}
         self.fallback = "bisection"
 
+    def _joints(self, state: ArrayLike) -> np.ndarray:
+        q = np.asarray(state, dtype=float)
+        if q.shape != (self.n,):
+            raise ValueError(f"state: expected {self.n} joint values, got {q.size}")
+        return q
+
     def _admits(self, q: np.ndarray) -> bool:
         return self.arm.within_limits(q)
 
     def state_valid(self, state: ArrayLike) -> bool:
-        """One collision query for a state not seen before (remembered)."""
-        q = np.asarray(state, dtype=float)
+        """One collision query for a state not seen before (remembered); ``ValueError`` for
+        a state of the wrong length, as the kernel's."""
+        q = self._joints(state)
         if not self._admits(q):
             return False
         key = q.tobytes()
@@ -187,9 +194,7 @@ class ArmEdgeCertifier:
         """True when the whole edge ``q1 -> q2`` is proven free (see the class docs)."""
         c = self.counters
         c["edges"] += 1
-        q1, q2 = np.asarray(state1, dtype=float), np.asarray(state2, dtype=float)
-        if q1.shape != (self.n,) or q2.shape != (self.n,):
-            raise ValueError(f"state: expected {self.n} joint values per state")
+        q1, q2 = self._joints(state1), self._joints(state2)
         if not (self._admits(q1) and self._admits(q2)):
             return self._reject("rejected_end_state")
         if not self.state_valid(q2):
