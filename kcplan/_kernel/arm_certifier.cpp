@@ -259,10 +259,7 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
         return true;
       },
       guards);
-  c.bisection_nodes += guards;
-  if (outcome == Advanced::kRejected) return reject(c.rejected_guard);
-  if (outcome == Advanced::kNotProven) return reject(c.not_proven);
-  c.certified_one_guard += guards == 1;
+  if (!c.settle(outcome, guards)) return false;
   covered_ball += 1.0;
   return true;
 }

@@ -201,11 +201,7 @@ bool EdgeCertifier::advance(const Edge& edge, double lo, double hi) {
         return true;
       },
       guards);
-  c.bisection_nodes += guards;
-  if (outcome == Advanced::kRejected) return reject(c.rejected_guard);
-  if (outcome == Advanced::kNotProven) return reject(c.not_proven);
-  c.certified_one_guard += guards == 1;
-  return true;
+  return c.settle(outcome, guards);
 }
 
 bool EdgeCertifier::sample(const Edge& edge, double resolution, double lo, double hi) {

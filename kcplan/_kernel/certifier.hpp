@@ -34,6 +34,18 @@ struct CertifierCounters {
                endpoint_guards = 0, cached_guards = 0, bisection_nodes = 0,
                collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0,
                probes = 0, probed_edges = 0;
+
+  /// Count how an advancement of `guards` guards ended; whether the edge is certified.
+  bool settle(Advanced outcome, int guards) {
+    bisection_nodes += guards;
+    if (outcome == Advanced::kCovered) {
+      certified_one_guard += guards == 1;
+      return true;
+    }
+    ++rejected;
+    ++(outcome == Advanced::kRejected ? rejected_guard : not_proven);
+    return false;
+  }
 };
 
 /// Options of an EdgeCertifier; the defaults are the Python certifier's.
