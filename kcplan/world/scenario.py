@@ -565,7 +565,7 @@ def as_scenario(value: Scenario | str | os.PathLike, rigid: bool = False) -> Sce
     """The scenario a public entry point was given: ``value`` itself when it is a
     :class:`Scenario` (or an arm's :class:`kcplan.arm.scenario.ArmScenario`), the file it
     names when it is a path (``str`` or ``os.PathLike``, read by :func:`load_scenario`).
-    ``rigid``: the caller handles rigid robots only (the views: arms are not drawn yet).
+    ``rigid``: the caller handles rigid robots only (such as :class:`kcplan.world.CollisionWorld`).
 
     Raises
     ------
@@ -581,7 +581,7 @@ def as_scenario(value: Scenario | str | os.PathLike, rigid: bool = False) -> Sce
     if isinstance(value, ArmScenario) and rigid:
         raise TypeError(
             f"scenario: {value.source}: expected a rigid robot of ellipsoids, got an "
-            f"{value.arm.describe()} (arms have kcplan.arm.ArmWorld and are not drawn yet)"
+            f"{value.arm.describe()} (an arm's scene is a kcplan.arm.ArmWorld)"
         )
     if isinstance(value, (Scenario, ArmScenario)):
         return value
