@@ -2,6 +2,7 @@
 
 import os
 import tempfile
+from pathlib import Path
 
 import numpy as np
 from hypothesis import settings
@@ -46,3 +47,19 @@ def arm_obstacles(specs=ARM_SCENE):
         "obstacles": specs,
     }  # fmt: skip
     return parse_scenario(data, check=False).obstacles
+
+
+PANDA = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "panda"
+"""The bundled MBM Panda (URDF, SRDF, collision meshes)."""
+PANDA_GROUP = [f"panda_joint{i}" for i in range(1, 8)]
+
+
+def panda_arm(bodies_per_link: int):
+    """The bundled Panda's 7-joint group, ``bodies_per_link`` ellipsoids per link, fitted
+    in the tests' private cover cache (once per test session and count)."""
+    from kcplan.arm import load_arm
+
+    return load_arm(
+        PANDA / "panda.urdf", PANDA_GROUP, srdf=PANDA / "panda.srdf",
+        bodies_per_link=bodies_per_link,
+    )  # fmt: skip

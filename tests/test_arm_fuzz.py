@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import arm_obstacles
+from conftest import PANDA, arm_obstacles, panda_arm
+from conftest import PANDA_GROUP as GROUP
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
@@ -25,19 +26,14 @@ from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
 from kcplan.world.scenario import ScenarioError
 
-ROOT = Path(__file__).resolve().parents[1]
-PANDA = ROOT / "scenarios" / "arm" / "panda"
-GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 MARGINS = [1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e100, 1e308]
 """How far outside a joint limit a fuzzed value lies (tiny to huge)."""
 FUZZ = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 @pytest.fixture(scope="module")
-def panda(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
-        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=1)
+def panda():
+    return panda_arm(bodies_per_link=1)
 
 
 @pytest.fixture(scope="module")

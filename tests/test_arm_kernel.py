@@ -3,26 +3,20 @@ Python reference (kcplan.arm.kinematics, kcplan.arm.bounds, kcplan.arm.world,
 kcplan.planning.arm_certifier) and against Pinocchio, with every accepted edge re-checked
 on the links' own meshes."""
 
-from pathlib import Path
-
 import fcl
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import arm_obstacles
+from conftest import arm_obstacles, panda_arm
 from scipy.spatial.transform import Rotation
 
-from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm import ArmWorld
 from kcplan.arm.bounds import carries, lever_growth, levers, point_speeds, relative_speeds
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
 from kcplan.world.scenario import Obstacle
-
-ROOT = Path(__file__).resolve().parents[1]
-PANDA = ROOT / "scenarios" / "arm" / "panda"
-GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 
 CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
     "cylinder", 3, {}, np.array([0.45, 0.35, 0.4]),
@@ -35,10 +29,8 @@ def _obstacles():
 
 
 @pytest.fixture(scope="module")
-def panda(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
-        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=2)
+def panda():
+    return panda_arm(bodies_per_link=2)
 
 
 @pytest.fixture(scope="module")

@@ -2,32 +2,26 @@
 them in OMPL, every accepted edge re-checked on the links' own meshes."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import arm_obstacles
+from conftest import arm_obstacles, panda_arm
 from ompl import base as ob
 from ompl import geometric as og
 
-from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm import ArmWorld
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
 from kcplan.planning.states import joint_space, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
 
-ROOT = Path(__file__).resolve().parents[1]
-PANDA = ROOT / "scenarios" / "arm" / "panda"
-GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
 
 
 @pytest.fixture(scope="module")
-def panda(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("KCPLAN_CACHE_DIR", str(tmp_path_factory.mktemp("covers")))
-        return load_arm(PANDA / "panda.urdf", GROUP, srdf=PANDA / "panda.srdf", bodies_per_link=1)
+def panda():
+    return panda_arm(bodies_per_link=1)
 
 
 @pytest.fixture(scope="module")
