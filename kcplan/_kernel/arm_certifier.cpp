@@ -246,14 +246,13 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     if (hi >= 1.0) return reject(c.rejected_end_state);
   }
   if (lo >= hi) return certified_by_endpoints();
-  std::vector<double> q(n_);
   int guards = 0;
   const Advanced outcome = advance(
       lo, hi, max_guards_, pending_,
       [&](double m, double s0, double s1, double& g_lo, double& g_hi) {
-        for (int j = 0; j < n_; ++j) q[j] = q1[j] + m * (q2[j] - q1[j]);
+        for (int j = 0; j < n_; ++j) q_[j] = q1[j] + m * (q2[j] - q1[j]);
         const double enough = 0.5 * (s1 - s0);  // this guard covers [s0, s1] with that
-        const double r = radius(measure(q.data(), enough), enough);
+        const double r = radius(measure(q_.data(), enough), enough);
         if (r <= 0.0) return false;
         g_lo = m - r, g_hi = m + r;
         return true;
