@@ -1,15 +1,16 @@
-"""VAMP's RRT-Connect on MotionBenchMaker Panda problems, its paths checked on the meshes.
+"""VAMP's RRT-Connect on MotionBenchMaker problems (Panda, UR5), its paths checked on the meshes.
 
 The peer of issue 25 (item 6), for benchmarks only: VAMP (KavrakiLab, ``vamp-planner``
 0.6.4) is never a dependency of kcplan. For the first ``--per-class`` problems of each
-class of VAMP's ``problems.tar.bz2`` (read by :mod:`kcplan.arm.mbm`):
+class of VAMP's ``problems.tar.bz2`` of ``--robot`` (``panda``, default, or ``ur5``; read
+by :mod:`kcplan.arm.mbm`):
 
 1. the scene is converted the way VAMP's own ``problem_tar_to_pkl_json.py`` and
    ``vamp.problem_dict_to_vamp`` do it: boxes are cuboids, cylinders capsules (in the
    ``box`` class cuboids of half extents ``(r, r, h / 2)``, VAMP's hack for its top-down
    grasp), spheres spheres; orientations as VAMP's ``euler_from_matrix`` (static xyz);
 2. VAMP's RRT-Connect plans with its default settings
-   (``vamp.configure_robot_and_planner_with_kwargs("panda", "rrtc")``, Halton sampler
+   (``vamp.configure_robot_and_planner_with_kwargs(ROBOT, "rrtc")``, Halton sampler
    reset before every call), ``--calls`` times per problem; the time is the median of
    VAMP's own ``PlanningResult.nanoseconds`` over the calls (planning, then
    simplification), in milliseconds;
@@ -52,8 +53,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-ARCHIVE = ROOT.parent / "shared" / "data" / "external" / "mbm" / "panda" / "problems.tar.bz2"
-PANDA = ROOT / "scenarios" / "arm" / "panda"
+MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"
+ROBOTS = {  # URDF folder of each robot: the bundled Panda, the UR5 as MBM ships it
+    "panda": ROOT / "scenarios" / "arm" / "panda",
+    "ur5": MBM / "ur5",
+}
 BUILD = "bash ../shared/tools/vamp/build-vamp.sh PYTHON"
 CLASSES = (
     "table_pick",
@@ -130,14 +134,14 @@ def vamp_problem(problem: dict) -> dict:
     return out
 
 
-def plan_problems(problems: list[dict], calls: int) -> list[dict]:
+def plan_problems(problems: list[dict], calls: int, robot: str = "panda") -> list[dict]:
     """VAMP's half: plan every problem ``calls`` times with VAMP's default RRT-Connect and
     simplify the first path; times in milliseconds (VAMP's own clock)."""
     import numpy as np
     import vamp
 
     module, rrtc, settings, simplify_settings = vamp.configure_robot_and_planner_with_kwargs(
-        "panda", "rrtc"
+        robot, "rrtc"
     )
     joints = list(module.joint_names())
     sampler = module.halton()
@@ -175,7 +179,7 @@ def plan_problems(problems: list[dict], calls: int) -> list[dict]:
     return results
 
 
-def verify_paths(archive: str, results: list[dict]) -> list[dict]:
+def verify_paths(archive: str, results: list[dict], robot: str = "panda") -> list[dict]:
     """kcplan's half: each solved path checked without gaps on the links' collision meshes
     (:func:`kcplan.arm.verify.verify_arm_path`); ``collides`` None when not solved."""
     import numpy as np
@@ -195,7 +199,7 @@ def verify_paths(archive: str, results: list[dict]) -> list[dict]:
                                  if j not in problem.joints))  # fmt: skip
             key = (problem.joints, fixed)
             if key not in arms:
-                arms[key] = _arm(load_arm, problem.joints, dict(fixed))
+                arms[key] = _arm(load_arm, robot, problem.joints, dict(fixed))
             check = verify_arm_path(
                 arms[key], problem.obstacles, np.asarray(result["path"]), allowed=problem.allowed
             )
@@ -208,15 +212,15 @@ def verify_paths(archive: str, results: list[dict]) -> list[dict]:
     return verdicts
 
 
-def _arm(load_arm, joints, fixed: dict):
-    """kcplan's Panda of the MBM problems: the group, and the other joints that the URDF
+def _arm(load_arm, robot: str, joints, fixed: dict):
+    """kcplan's arm of the MBM problems: the group, and the other joints that the URDF
     has fixed at their start values (as ``kcplan import mbm`` does). The verifier checks
     the links' meshes, not their cover: one body per link, the quickest cover to fit."""
     import pinocchio as pin
 
-    model = pin.buildModelFromUrdf(os.fspath(PANDA / "panda.urdf"))
+    urdf, srdf = ROBOTS[robot] / f"{robot}.urdf", ROBOTS[robot] / f"{robot}.srdf"
+    model = pin.buildModelFromUrdf(os.fspath(urdf))
     fixed = {j: v for j, v in fixed.items() if model.existJointName(j)}
-    urdf, srdf = PANDA / "panda.urdf", PANDA / "panda.srdf"
     return load_arm(urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=1)
 
 
@@ -243,7 +247,7 @@ def _run_step(step: str, payload: dict, args: argparse.Namespace) -> list[dict]:
     python = args.vamp_python if half == "vamp" else args.kcplan_python
     command = [python, os.fspath(Path(__file__).resolve()), "--step", step,
                "--archive", args.archive, "--per-class", str(args.per_class),
-               "--calls", str(args.calls)]  # fmt: skip
+               "--calls", str(args.calls), "--robot", args.robot]  # fmt: skip
     proc = subprocess.run(
         command, input=json.dumps(payload), capture_output=True, text=True, cwd=ROOT
     )
@@ -256,8 +260,8 @@ def _step(step: str, payload: dict, args: argparse.Namespace) -> list[dict]:
     if step == "read":
         return read_problems(args.archive, args.per_class)
     if step == "plan":
-        return plan_problems(payload["problems"], args.calls)
-    return verify_paths(args.archive, payload["results"])
+        return plan_problems(payload["problems"], args.calls, args.robot)
+    return verify_paths(args.archive, payload["results"], args.robot)
 
 
 def table(results: list[dict], verdicts: list[dict]) -> list[str]:
@@ -290,7 +294,8 @@ def _median(values: list[float]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--archive", default=os.fspath(ARCHIVE), help="VAMP's problems.tar.bz2")
+    parser.add_argument("--robot", choices=sorted(ROBOTS), default="panda")
+    parser.add_argument("--archive", help="VAMP's problems.tar.bz2 (default: the robot's)")
     parser.add_argument("--per-class", type=int, default=3, help="problems per class (first N)")
     parser.add_argument("--calls", type=int, default=5, help="VAMP calls per problem (median)")
     parser.add_argument("--vamp-python", help="a Python with vamp, when this one has none")
@@ -302,6 +307,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", help="also write every result and verdict to this file")
     parser.add_argument("--step", choices=sorted(STEPS), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.archive is None:
+        args.archive = os.fspath(MBM / args.robot / "problems.tar.bz2")
     if args.per_class < 1 or args.calls < 1:
         parser.error("--per-class and --calls: expected positive integers")
     if args.step is not None:  # one half, for the other Python: JSON in, JSON out

@@ -7,7 +7,7 @@ import fcl
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import arm_obstacles, panda_arm
+from conftest import AXES_A, AXES_B, FRAME_A, FRAME_B, arm_obstacles, panda_arm
 from scipy.spatial.transform import Rotation
 
 from kcplan.arm import ArmWorld
@@ -136,19 +136,6 @@ def test_both_clearances_are_lower_bounds_of_the_sampled_distance(panda, world, 
         np.testing.assert_allclose(k_scene, p_scene, atol=0.02)
 
 
-# two of the Panda's covering ellipsoids (K = 4) at a state of box_1: frames and semi-axes
-FRAME_A = [
-    [-0.258527440075, -0.782940024823, 0.56583432227, -0.231000054592],
-    [-0.790483528887, 0.508143301405, 0.341944696983, 0.005782809322],
-    [-0.555247110111, -0.358880624676, -0.750270180632, 0.29465356976],
-]
-FRAME_B = [
-    [-0.469978999907, 0.527399294467, -0.707792147344, -0.409912721165],
-    [-0.818900442519, 0.038745536239, 0.572626273116, 0.015912278893],
-    [0.329426478729, 0.848733625832, 0.413677927251, 0.21608404707],
-]
-AXES_A = [0.037072799508, 0.065385681018, 0.082023441791]
-AXES_B = [0.007962846033, 0.016329866169, 0.028091109846]
 
 
 def test_fcl_overestimates_thin_ellipsoids_and_the_arm_world_does_not():

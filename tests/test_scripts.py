@@ -293,6 +293,20 @@ CASES.append(
     else Case("vamp_mbm.py", ("--step", "read", "--per-class", "1"), check=_vamp_problems)
 )
 
+CASES.append(
+    Case(  # the 4-body cover: the bundled scenarios' (arm_edge_cost.py's case fits it first)
+        "mbm_bench.py",
+        ("--per-class", "1", "--classes", "table_pick", "--bodies-per-link", "4")
+        + ("--planners", "kc-rrtconnect,rrtconnect", "--time", "2", "-o", "{tmp}"),
+        (
+            r"^\| class \| problems \| invalid for the cover \| kc-rrtconnect solved \| ",
+            rf"^\| table_pick \| 1 \| 0 \| 1 / 1 \| {NUMBER} \| 0 \| 1 / 1 \| {NUMBER} \| 0 \|$",
+            rf"^\| all \| 1 \| 0 \| 1 / 1 \| {NUMBER} \| 0 \| 1 / 1 \| {NUMBER} \| 0 \|$",
+        ),
+        ("mbm_table.md", "bench/summary.csv", "scenarios/table_pick_1.yaml"),
+    )
+)
+
 
 @pytest.mark.skipif(HAVE_VAMP, reason="VAMP is installed here")
 def test_vamp_mbm_without_vamp_says_how_to_build_it():

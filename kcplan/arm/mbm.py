@@ -248,12 +248,15 @@ def mbm_scenario(
     urdf: str | os.PathLike,
     srdf: str | os.PathLike | None,
     output: str | os.PathLike,
-    bodies_per_link: int = 4,
+    bodies_per_link: int | None = 4,
+    max_offset: float | None = None,
 ) -> dict:
     """The arm scenario (:mod:`kcplan.arm.scenario`, as plain data) of one problem: its
     obstacles, start and goal for the goal's joints, every other joint of the URDF fixed
     at its start value, and the allowed collision matrix; robot paths relative to the
-    folder of ``output``."""
+    folder of ``output``. ``bodies_per_link`` and ``max_offset`` (metres) choose the
+    cover as the scenario's fields of those names do; both None: kcplan's default cover
+    (:data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`)."""
     import pinocchio as pin
 
     folder = Path(output).resolve().parent
@@ -266,7 +269,11 @@ def mbm_scenario(
     robot: dict = {"urdf": os.path.relpath(Path(urdf).resolve(), folder)}
     if srdf is not None:
         robot["srdf"] = os.path.relpath(Path(srdf).resolve(), folder)
-    robot |= {"joints": list(problem.joints), "bodies_per_link": int(bodies_per_link)}
+    robot["joints"] = list(problem.joints)
+    if bodies_per_link is not None:
+        robot["bodies_per_link"] = int(bodies_per_link)
+    if max_offset is not None:
+        robot["max_offset"] = float(max_offset)
     if fixed:
         robot["fixed"] = fixed
     return {

@@ -39,7 +39,7 @@ from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario, as_scenario
-from kcplan.world.support import box_vertices, piece_supports
+from kcplan.world.support import EllipsoidSupport, box_vertices, piece_supports, separation
 
 __all__ = [
     "CLEARANCE_RTOL",
@@ -50,10 +50,13 @@ __all__ = [
 ]
 
 CLEARANCE_RTOL = 2e-3
-"""Relative error allowed for FCL's iterative (GJK) distances. FCL *over*-estimates
-distances between curved shapes: on 3000 random ellipsoid-sphere pairs the excess reached
-3.1e-4 of the distance (1.8e-3 at distance 5.7); against the planar polygon oracle 3e-5.
-Certificates use ``d (1 - RTOL) - ATOL``, about 6 times the worst excess seen."""
+"""Relative error allowed for FCL's iterative (GJK) distances to mesh pieces (which have
+no support function). FCL *over*-estimates distances between curved shapes: on 3000
+random ellipsoid-sphere pairs the excess reached 3.1e-4 of the distance; between thin
+ellipsoids it reached 7.6 % (RESULTS 11.2), so a distance to a convex piece is not
+trusted at all: the world takes FCL's direction and the exact support functions'
+separation along it (:func:`kcplan.world.support.separation`), and subtracts ``d RTOL +
+ATOL`` besides."""
 CLEARANCE_ATOL = 1e-6
 """Absolute error allowed for FCL distances, as a fraction of the scene's size (the
 largest side of the bounds): near contact the excess is absolute (4.5e-6 at distance
@@ -311,22 +314,97 @@ class CollisionWorld:
     def body_clearances(self, pose: ArrayLike) -> NDArray[np.float64]:
         """Distance from each body of the robot at ``pose`` to the nearest obstacle, shape
         ``(k,)``: 0 when the body touches or overlaps one, ``inf`` without obstacles (one
-        distance query; one FCL query per body). In length units. FCL's GJK is iterative
-        and may overestimate by up to :data:`CLEARANCE_RTOL` relative plus
-        :data:`CLEARANCE_ATOL`: see :meth:`safe_body_clearances`."""
+        distance query; one FCL query per body). In length units. To a convex piece it is
+        a lower bound whatever FCL's error (:meth:`_body_distance`); to a mesh piece it is
+        FCL's, which may overestimate: see :meth:`safe_body_clearances`."""
         self._place(pose)
         self._fcl_counters["distance_queries"] += 1
         if not self._objects:
             return np.full(len(self._bodies), math.inf)
         out = np.empty(len(self._bodies))
-        for k, body in enumerate(self._bodies):
+        for k in range(len(self._bodies)):
             self._count_body(k)
-            out[k] = self._distance(body)
+            out[k] = self._body_distance(k)
         return out
 
+    def _body_support(self, k: int) -> EllipsoidSupport:
+        """The exact support function of body ``k`` as placed, in the scenario's
+        dimension."""
+        n, body = self.dimension, self._bodies[k]
+        rotation = np.asarray(body.getRotation(), dtype=float)[:n, :n]
+        centre = np.asarray(body.getTranslation(), dtype=float)[:n]
+        return EllipsoidSupport(centre, rotation, self.robot.bodies[k].semi_axes)
+
+    def _pair_distance(
+        self, k: int, support: EllipsoidSupport, piece: fcl.CollisionObject
+    ) -> tuple[float, float, NDArray | None, object]:
+        """FCL's distance between body ``k`` and ``piece``, a lower bound of the true one
+        (0 on contact), FCL's unit direction from the piece towards the body (None on
+        contact or for a mesh piece, whose lower bound is FCL's distance itself) and the
+        piece's support function (None for a mesh).
+
+        The lower bound is the separation of the exact support functions along FCL's
+        direction (:func:`kcplan.world.support.separation`), never too large whatever
+        FCL's error. FCL's GJK errs differently with the pair's order (the thin pair of
+        RESULTS 11.2: 7.6 % over with the body first, right with the piece first; a
+        direction off by 10 degrees near contact in hand_through_slot), so when the
+        first direction does not confirm FCL's distance the pair is asked the other way
+        round too and the better bound kept."""
+        body, n = self._bodies[k], self.dimension
+        fcl_d, low, u, piece_support = math.inf, 0.0, None, None
+        for first, second in ((body, piece), (piece, body)):
+            result = fcl.DistanceResult()
+            d = fcl.distance(first, second, self._pair_request, result)
+            if d <= 0.0:
+                return 0.0, 0.0, None, None
+            fcl_d = min(fcl_d, d)
+            # FCL swaps the pair (and its nearest points) for some geometry types; its
+            # result names the geometries we made (callbacks pass new object wrappers)
+            if result.o1 is self._geometries[k]:
+                geometry, (p_body, p_piece) = result.o2, result.nearest_points
+            else:
+                geometry, (p_piece, p_body) = result.o1, result.nearest_points
+            piece_support = self._support_of[id(geometry)]
+            if piece_support is None:  # a mesh: FCL's distance, under the allowance
+                return d, d, None, None
+            direction = np.asarray(p_body, dtype=float)[:n] - np.asarray(p_piece, dtype=float)[:n]
+            length = math.sqrt(float(direction @ direction))
+            if length == 0.0:
+                continue
+            v = direction / length  # from the piece towards the body
+            bound = min(max(separation(piece_support, support, v), 0.0), d)
+            if bound > low:
+                low, u = bound, v
+            if low >= d * (1.0 - CLEARANCE_RTOL):  # the direction confirms FCL's distance
+                break
+        return fcl_d, low, u, piece_support
+
+    def _body_distance(self, k: int) -> float:
+        """A lower bound of the distance from body ``k`` (placed) to every obstacle: the
+        broad phase visits the pieces nearer than the smallest FCL distance so far, each
+        is bounded by :meth:`_pair_distance`, and a piece the broad phase skips is farther
+        than that FCL distance, which therefore bounds the answer too."""
+        support = self._body_support(k)
+        smallest = [math.inf, math.inf]  # FCL's distance (the pruning bound), lower bound
+        failures: list[BaseException] = []
+
+        def visit(piece, _robot, _data):  # the manager passes the robot as o2
+            try:
+                d, low, _, _ = self._pair_distance(k, support, piece)
+            except BaseException as err:  # python-fcl would print it and carry on
+                failures.append(err)
+                return True, 0.0
+            smallest[0], smallest[1] = min(smallest[0], d), min(smallest[1], low)
+            return smallest[1] <= 0.0, smallest[0]
+
+        self._manager.distance(self._bodies[k], None, visit)
+        if failures:
+            raise failures[0]
+        return max(min(smallest), 0.0)
+
     def _distance(self, obj: fcl.CollisionObject) -> float:
-        """One broad- and narrow-phase distance query of ``obj`` against the obstacles
-        (0 on contact or overlap)."""
+        """One broad- and narrow-phase distance query of any FCL object (placed by the
+        caller) against the obstacles, FCL's distance (0 on contact or overlap)."""
         data = fcl.DistanceData()
         self._manager.distance(obj, data, fcl.defaultDistanceCallback)
         return max(float(data.result.min_distance), 0.0)
@@ -343,7 +421,8 @@ class CollisionWorld:
     def safe_body_clearances(self, pose: ArrayLike) -> NDArray[np.float64]:
         """:meth:`body_clearances` reduced by FCL's error allowance, distances that are
         certain: ``max(d (1 - CLEARANCE_RTOL) - clearance_atol, 0)`` with
-        ``clearance_atol = CLEARANCE_ATOL * scene size`` (one distance query)."""
+        ``clearance_atol = CLEARANCE_ATOL * scene size`` (one distance query; to convex
+        pieces ``d`` is already a lower bound, the allowance is for mesh pieces)."""
         return self._safe(self.body_clearances(pose))
 
     def object_clearance(self, obj: fcl.CollisionObject) -> float:
@@ -390,14 +469,14 @@ class CollisionWorld:
         if not self._objects:
             return (FreeRegion.empty(n, math.inf),) * len(self._bodies)
         regions = []
-        request, rtol = self._pair_request, 1.0 - CLEARANCE_RTOL
+        rtol = 1.0 - CLEARANCE_RTOL
         near: list[fcl.CollisionObject] = []
 
         def collect(o1, _o2, _data) -> bool:
             near.append(o1)
             return False  # keep going: every piece in the box
 
-        for k, (body, geometry) in enumerate(zip(self._bodies, self._geometries, strict=True)):
+        for k, body in enumerate(self._bodies):
             self._count_body(k)
             box = self._horizon_box(k, horizon)
             box.setTranslation(body.getTranslation())
@@ -406,32 +485,22 @@ class CollisionWorld:
             self._fcl_counters["region_pairs"] += len(near)
             if not near:  # open space: the clearance to everything is the better horizon
                 self._fcl_counters["distance_queries"] += 1
-                data = fcl.DistanceData()
-                self._manager.distance(body, data, fcl.defaultDistanceCallback)
-                d = max(float(data.result.min_distance), 0.0)
+                d = self._body_distance(k)
                 regions.append(FreeRegion.empty(n, max(horizon, d * rtol - self.clearance_atol)))
                 continue
             normals, offsets, clearances = [], [], []
-            for obstacle in near:
-                result = fcl.DistanceResult()
-                d = fcl.distance(body, obstacle, request, result)
+            support = self._body_support(k)
+            for piece in near:
+                d, low, u, piece_support = self._pair_distance(k, support, piece)
                 if d <= 0.0:
                     return (FreeRegion.colliding(n),) * len(self._bodies)
-                clearances.append(max(d * rtol - self.clearance_atol, 0.0))
-                # FCL swaps the pair (and its nearest points) for some geometry types (meshes)
-                if result.o1 is geometry:
-                    piece, (p_body, p_obstacle) = result.o2, result.nearest_points
-                else:
-                    piece, (p_obstacle, p_body) = result.o1, result.nearest_points
-                support = self._support_of[id(piece)]
-                direction = (p_body - p_obstacle)[:n]
-                length = math.sqrt(float(direction @ direction))
-                if support is None or length == 0.0:
+                clearances.append(max(low * rtol - self.clearance_atol, 0.0))
+                if u is None:  # a mesh piece (or a degenerate direction): its clearance only
                     normals.append(np.zeros(n))
                     offsets.append(math.inf)
                     continue
-                normals.append(direction / length)
-                offsets.append(support(normals[-1]))
+                normals.append(u)
+                offsets.append(piece_support(u))
             regions.append(
                 FreeRegion(
                     np.array(normals).reshape(-1, n),
