@@ -209,3 +209,38 @@ def test_the_kernel_never_certifies_a_bad_state(panda, world, states):
         kernel.check(q, q[:6])
     with pytest.raises(ValueError, match="finite joint values"):
         world.kernel.in_collision([np.nan] * panda.dof)
+
+
+def test_part_balls_decide_every_edge_as_every_pair_does(panda, world, states):
+    """Deciding far groups of self pairs by the links' balls (the default) changes no
+    radius: the same decisions and the same guards as looking at every pair, with groups
+    actually skipped."""
+    free = [q for q in states if not world.in_collision(q)][:60]
+    grouped, every = KernelArmCertifier(world), KernelArmCertifier(world, part_balls=False)
+    rng = np.random.default_rng(11)
+    for q1, q2 in zip(free, free[1:], strict=False):
+        for t in (0.05, 0.3, 1.0):
+            end = q1 + t * (q2 - q1)
+            assert grouped.check(q1, end) == every.check(q1, end)
+        other = free[rng.integers(len(free))]
+        assert grouped.check(other, q1) == every.check(other, q1)
+    g, e = grouped.counters, every.counters
+    for name in ARM_COUNTER_NAMES:
+        assert g[name] == e[name], name
+    assert g["skipped_groups"] > 0 and e["skipped_groups"] == 0
+    assert g["rejected"] > 0 and g["certified_by_endpoints"] + g["certified_one_guard"] > 0
+
+
+def test_a_self_colliding_end_is_not_remembered_as_valid(panda):
+    """Pairs are measured lazily, but an end guard at a self-colliding state still
+    rejects its edge and leaves the state invalid in the cache."""
+    alone = ArmWorld(panda, ())  # no obstacles: a collision is a self-collision
+    states = np.random.default_rng(3).uniform(panda.lower, panda.upper, size=(400, panda.dof))
+    touching = [q for q in states if alone.in_collision(q)]
+    free = [q for q in states if not alone.in_collision(q)]
+    assert touching and free
+    certifier = KernelArmCertifier(alone, probes=False)  # straight to the end guards
+    for q in touching[:10]:
+        assert not certifier.check(q, free[0])  # q1 is assumed valid: the guard finds it
+        assert not certifier.state_valid(q)
+    assert certifier.counters["rejected_guard"] == min(10, len(touching))

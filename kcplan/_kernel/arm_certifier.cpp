@@ -16,9 +16,11 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       n_(world.chain().dof()),
       max_guards_(options.max_guards),
       probes_(options.probes),
+      part_balls_(options.part_balls),
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
-      rho_pairs_(world.chain().relative_speeds(world.pairs())) {
+      rho_pairs_(world.chain().relative_speeds(world.pairs())),
+      rho_groups_(world.parts().relative_speeds(world.groups())) {
   if (max_guards_ < 1) throw std::invalid_argument("max_guards: expected at least 1");
   speed_.resize(chain_.bodies().size());
   pair_speed_.resize(world.pairs().size());
@@ -33,6 +35,16 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       const bool ck = C[k * n_ + j], cl = C[l * n_ + j];
       only_first_.push_back(ck && !cl), only_second_.push_back(cl && !ck);
     }
+  const std::vector<bool>& P = world.parts().carries();
+  for (const auto& [p, q] : world.groups())
+    for (int j = 0; j < n_; ++j) {
+      const bool cp = P[p * n_ + j], cq = P[q * n_ + j];
+      group_first_.push_back(cp && !cq), group_second_.push_back(cq && !cp);
+    }
+  group_speed_.resize(world.groups().size());
+  group_growth_.resize(world.groups().size());
+  group_t_.resize(world.groups().size());
+  part_growth_.resize(world.parts().bodies().size() * n_);
 }
 
 double ArmCertifier::reach(double d, double v, double A, double Q) {
@@ -56,6 +68,40 @@ void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double
     A += dq_[j] * (only_first_[m * n_ + j] * guard.levers[a * n_ + j] +
                    only_second_[m * n_ + j] * guard.levers[b * n_ + j]);
   Q = pair_growth_[m];
+}
+
+double ArmCertifier::group_reach(const ArmGuard& guard, std::size_t g) const {
+  const double v = group_speed_[g];
+  if (!(v > 0.0)) return std::numeric_limits<double>::infinity();
+  const auto [p, q] = world_.groups()[g];
+  double A = 0.0;
+  for (int j = 0; j < n_; ++j)
+    A += dq_[j] * (group_first_[g * n_ + j] * guard.part_levers[p * n_ + j] +
+                   group_second_[g * n_ + j] * guard.part_levers[q * n_ + j]);
+  const double gap = world_.group_gap(g, guard.part_centres.data());
+  return reach(std::max(gap, 0.0), v, A, group_growth_[g]);
+}
+
+template <class Frames>
+void ArmCertifier::pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
+                               Frames& frames) {
+  const double v = pair_speed_[m];
+  if (!(v > 0.0)) return;
+  if (!guard.pair_known[m]) {
+    guard.pairs[m] = std::max(world_.pair_gap(m, frames()), 0.0);
+    guard.pair_known[m] = 1;
+  }
+  double A, Q;
+  terms(guard, speed_.size() + m, A, Q);
+  double t = reach(guard.pairs[m], v, A, Q);
+  if (guard.pair_known[m] == 1 && t < std::min(r, enough)) {
+    guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
+    guard.pair_known[m] = 2;
+    ++refined_pairs;
+    if (!(guard.pairs[m] > 0.0)) guard.clearance = 0.0;  // in contact: the state is not free
+    t = reach(guard.pairs[m], v, A, Q);
+  }
+  r = std::min(r, t);
 }
 
 bool ArmCertifier::reject(std::int64_t& reason) {
@@ -112,9 +158,15 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   g.pairs.resize(pairs);
   g.levers.resize(bodies * n_);
   g.scene_exact.assign(bodies, !(enough > 0.0));
-  g.pair_exact.assign(pairs, 0);
+  g.pair_known.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
+  const Chain& parts = world_.parts();
+  parts.place_bodies(world_.joint_frames(), part_frames_);
+  g.part_levers.resize(parts.bodies().size() * n_);
+  parts.levers(world_.joint_frames(), part_frames_, g.part_levers.data());
+  for (const coal::Transform3s& f : part_frames_)
+    for (int i = 0; i < 3; ++i) g.part_centres.push_back(f.getTranslation()[i]);
   if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2)
     double A, Q;
     for (std::size_t k = 0; k < bodies; ++k) {
@@ -128,11 +180,13 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   }
   g.clearance = std::numeric_limits<double>::infinity();
   for (double d : g.scene) g.clearance = std::min(g.clearance, d);
+  if (part_balls_ && enough > 0.0) return g;  // the pairs when a radius asks (pair_radius)
   for (std::size_t m = 0; m < pairs; ++m) {
     g.pairs[m] = world_.pair_gap(m, frames);
+    g.pair_known[m] = 1;
     if (g.pairs[m] <= 0.0) {  // the balls meet: only GJK can tell whether the bodies do
       g.pairs[m] = world_.pair_clearance(m, frames);
-      g.pair_exact[m] = 1;
+      g.pair_known[m] = 2;
     }
     g.clearance = std::min(g.clearance, g.pairs[m]);
   }
@@ -168,18 +222,21 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
     }
     r = std::min(r, t);
   }
-  for (std::size_t m = 0; m < pair_speed_.size(); ++m) {
-    const double v = pair_speed_[m];
-    if (!(v > 0.0)) continue;
-    terms(guard, bodies + m, A, Q);
-    double t = reach(guard.pairs[m], v, A, Q);
-    if (!guard.pair_exact[m] && t < std::min(r, enough)) {
-      guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
-      guard.pair_exact[m] = 1;
-      ++refined_pairs;
-      t = reach(guard.pairs[m], v, A, Q);
+  if (!part_balls_) {
+    for (std::size_t m = 0; m < pair_speed_.size(); ++m) pair_radius(guard, m, enough, r, frames);
+    return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
+  }
+  // a group whose gap gives its pairs at least r cannot lower r (the class docs)
+  std::fill(group_t_.begin(), group_t_.end(), -1.0);
+  for (const ArmWorld::Run& run : world_.runs()) {
+    if (!(r > 0.0)) return 0.0;
+    double& t = group_t_[run.group];
+    if (t < 0.0) t = group_reach(guard, run.group);
+    if (t >= r) {
+      ++skipped_groups;
+      continue;
     }
-    r = std::min(r, t);
+    for (std::size_t m = run.begin; m < run.end; ++m) pair_radius(guard, m, enough, r, frames);
   }
   return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
 }
@@ -219,6 +276,23 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
       Q += only_first_[m * dof + j] * growth_[a * dof + j] +
            only_second_[m * dof + j] * growth_[b * dof + j];
     pair_growth_[m] = Q;
+  }
+  if (part_balls_) {
+    const Chain& parts = world_.parts();
+    for (std::size_t g = 0; g < group_speed_.size(); ++g) {
+      double v = 0.0;
+      for (std::size_t j = 0; j < dof; ++j) v += rho_groups_[g * dof + j] * dq_[j];
+      group_speed_[g] = v;
+    }
+    parts.lever_growth(dq_.data(), part_growth_.data());
+    for (std::size_t g = 0; g < group_growth_.size(); ++g) {
+      const auto [p, q] = world_.groups()[g];
+      double Q = 0.0;
+      for (std::size_t j = 0; j < dof; ++j)
+        Q += group_first_[g * dof + j] * part_growth_[p * dof + j] +
+             group_second_[g * dof + j] * part_growth_[q * dof + j];
+      group_growth_[g] = Q;
+    }
   }
   const ArmGuardCache::Key k1 = ArmGuardCache::key_of(q1, n_), k2 = ArmGuardCache::key_of(q2, n_);
   std::shared_ptr<const ArmGuard> g1 = cache_.guard(k1), g2 = cache_.guard(k2);

@@ -19,16 +19,24 @@ namespace kcplan {
 ///
 /// `scene[k]` is a certain lower bound of body k's clearance to the obstacles: its
 /// clearance, or (when `scene_exact[k]` is 0) a cap below it, as much as the edge it was
-/// measured for needed; `pairs[m]` a certain lower bound of self pair m's distance, first
-/// the bounding balls' gap (ArmWorld::pair_gap), raised to the pair's GJK distance the
-/// first time a certificate needs more (`pair_exact`). Raising a lower bound never makes
-/// it wrong, so a cached guard is refined in place when another edge needs more of it.
+/// measured for needed; `pairs[m]` a certain lower bound of self pair m's distance once
+/// known (`pair_known[m]`: 0 not yet, 1 the bounding balls' gap ArmWorld::pair_gap, 2 the
+/// pair's GJK distance), each asked the first time a certificate needs it. Raising a lower
+/// bound never makes it wrong, so a cached guard is refined in place when another edge
+/// needs more of it. The parts' levers and centres decide far groups of pairs at once
+/// (ArmWorld::parts).
 struct ArmGuard {
   std::array<double, Chain::kMaxJoints> q{};
-  std::vector<double> levers;  ///< Chain::levers at q: bodies x dof
+  std::vector<double> levers;        ///< Chain::levers at q: bodies x dof
+  std::vector<double> part_levers;   ///< the same of ArmWorld::parts(): parts x dof
+  std::vector<double> part_centres;  ///< the parts' centres at q: 3 per part
   mutable std::vector<double> scene, pairs;
-  mutable std::vector<char> scene_exact, pair_exact;
-  double clearance = 0.0;  ///< > 0: the state is free (the smallest bound, once exact)
+  mutable std::vector<char> scene_exact, pair_known;
+  /// > 0: no body at q is known to touch anything (the scene's smallest bound, and of the
+  /// pairs known); set to 0 when a pair is found in contact. A guard whose pairs are not
+  /// all known is cached only at an end of an edge, whose radius() is asked at once: a
+  /// pair in contact is then found (its group's gap is not positive).
+  mutable double clearance = 0.0;
 };
 
 /// The guards of an arm, keyed by the joint vector.
@@ -38,6 +46,10 @@ using ArmGuardCache = StateCache<Chain::kMaxJoints, ArmGuard>;
 struct ArmCertifierOptions {
   int max_guards = 256;  ///< guards per edge after the endpoints before "not proven"
   bool probes = true;    ///< collision probes of the open stretch before any guard
+  /// Decide the self pairs of a far group of parts at once (ArmWorld::parts) and ask a
+  /// pair's gap only when its group is near; false: every pair at every guard (the
+  /// ablation; the radii are the same, kcplan/planning/arm_certifier.py decides so too).
+  bool part_balls = true;
   std::size_t cache_entries = 200000;
 };
 
@@ -63,7 +75,11 @@ struct ArmCertifierOptions {
 /// guard in the middle of each stretch left open until none is (certified), one is in
 /// contact (rejected) or max_guards were placed ("not proven", rejected). A self pair's exact
 /// distance is asked only when its balls' gap would limit a radius: the radius is then
-/// exactly the one of exact distances. Not thread-safe (the world's objects are reused).
+/// exactly the one of exact distances. With part_balls, a group of pairs whose parts'
+/// balls (ArmWorld::parts) give every pair of it at least the radius the others allow is
+/// not looked at: its pairs could not lower that radius (each pair's distance is at least
+/// its group's gap, its speeds at most its parts'), so the radius is the same.
+/// Not thread-safe (the world's objects are reused).
 class ArmCertifier {
  public:
   ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options);
@@ -99,9 +115,11 @@ class ArmCertifier {
   const ArmGuardCache& cache() const { return cache_; }
   int max_guards() const { return max_guards_; }
   bool probes() const { return probes_; }
+  bool part_balls() const { return part_balls_; }
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
   CertifierCounters counters;
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
+  std::int64_t skipped_groups = 0;  ///< groups of pairs a radius decided by their parts
   std::int64_t refined_bodies = 0;  ///< capped scene clearances measured again, uncapped
 
  private:
@@ -113,18 +131,28 @@ class ArmCertifier {
   ArmWorld& world_;
   const Chain& chain_;
   int n_, max_guards_;
-  bool probes_;
+  bool probes_, part_balls_;
   ArmGuardCache cache_;
   /// The radius a clearance d gives to a body or pair of global speed v, lever term A
   /// and growth Q (the class docs).
   static double reach(double d, double v, double A, double Q);
   /// A and Q of body k (k < bodies) or of pair k - bodies, for the current edge.
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
+  /// The radius group g's gap gives all its pairs, for the current edge.
+  double group_reach(const ArmGuard& guard, std::size_t g) const;
+  /// Self pair m's part of radius(): its bound asked if not known, refined if it would
+  /// hold r below min(r, enough), then r lowered to what it gives.
+  /// `frames()` gives the bodies' frames at the guard (computed on first use).
+  template <class Frames>
+  void pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
+                   Frames& frames);
 
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
   std::vector<double> speed_, pair_speed_, q_, caps_, dq_, growth_, pair_growth_;
-  std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
+  std::vector<double> rho_groups_, group_speed_, group_growth_, part_growth_, group_t_;
+  std::vector<double> group_first_, group_second_;  // groups x dof: joint carries one part only
+  std::vector<coal::Transform3s> joints_, frames_, part_frames_;  // scratch
   std::vector<std::pair<double, double>> pending_;
 };
 

@@ -1,5 +1,6 @@
 #include "arm_world.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -25,16 +26,66 @@ Robot bodies_of(const Chain& chain) {
   return Robot(3, semi_axes, poses, Robot::kMaxArmBodies);
 }
 
+/// Which part each body belongs to: parts are numbered by the first body of their joint.
+std::vector<int> parts_of(const Chain& chain) {
+  std::vector<int> part_of_joint(chain.joint_count(), -1), out;
+  int parts = 0;
+  for (const ChainBody& b : chain.bodies()) {
+    if (part_of_joint[b.joint] < 0) part_of_joint[b.joint] = parts++;
+    out.push_back(part_of_joint[b.joint]);
+  }
+  return out;
+}
+
+/// The parts' balls, in their joints' frames: centred on the box of the bodies' bounding
+/// balls, with a radius enclosing each of them (a_max of a ball is its radius).
+Chain part_chain(const Chain& chain, const std::vector<int>& part_of) {
+  const int parts = part_of.empty() ? 0 : *std::max_element(part_of.begin(), part_of.end()) + 1;
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<coal::Vec3s> lo(parts, coal::Vec3s::Constant(inf)), hi(parts, coal::Vec3s::Constant(-inf));
+  std::vector<ChainBody> balls(parts);
+  for (std::size_t k = 0; k < part_of.size(); ++k) {
+    const ChainBody& b = chain.bodies()[k];
+    const coal::Vec3s& c = b.placement.getTranslation();
+    lo[part_of[k]] = lo[part_of[k]].cwiseMin(c - coal::Vec3s::Constant(b.a_max));
+    hi[part_of[k]] = hi[part_of[k]].cwiseMax(c + coal::Vec3s::Constant(b.a_max));
+    balls[part_of[k]].joint = b.joint;
+  }
+  for (int p = 0; p < parts; ++p)
+    balls[p].placement = coal::Transform3s(coal::Matrix3s::Identity(), 0.5 * (lo[p] + hi[p]));
+  for (std::size_t k = 0; k < part_of.size(); ++k) {
+    const ChainBody& b = chain.bodies()[k];
+    ChainBody& ball = balls[part_of[k]];
+    const double r = (b.placement.getTranslation() - ball.placement.getTranslation()).norm() + b.a_max;
+    ball.a_max = std::max(ball.a_max, r * (1.0 + 1e-12));  // rounding: the ball must hold
+  }
+  for (ChainBody& ball : balls) ball.semi_axes = {ball.a_max, ball.a_max, ball.a_max};
+  return chain.with_bodies(std::move(balls));
+}
+
 }  // namespace
 
 ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pairs, double rtol,
                    double atol)
-    : chain_(chain), pairs_(pairs) {
+    : chain_(chain),
+      part_of_(parts_of(chain)),
+      parts_(part_chain(chain, part_of_)),
+      pairs_(pairs) {
   const int count = static_cast<int>(chain.bodies().size());
   for (const auto& [k, l] : pairs)
     if (k < 0 || l < 0 || k >= count || l >= count || k == l)
       throw std::invalid_argument("pairs: expected two different body indices below " +
                                   std::to_string(count));
+  for (std::size_t m = 0; m < pairs.size(); ++m) {
+    const std::array<int, 2> group{part_of_[pairs[m][0]], part_of_[pairs[m][1]]};
+    const auto it = std::find(groups_.begin(), groups_.end(), group);
+    group_of_.push_back(static_cast<int>(it - groups_.begin()));
+    if (it == groups_.end()) groups_.push_back(group);
+    if (runs_.empty() || runs_.back().group != group_of_.back())
+      runs_.push_back({m, m + 1, group_of_.back()});
+    else
+      runs_.back().end = m + 1;
+  }
   scene_ = std::make_unique<World>(bodies_of(chain), 1.0, rtol, atol);
   for (const ChainBody& b : chain.bodies())
     shapes_.push_back(
@@ -59,6 +110,15 @@ double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& f
   const double centres = (frames[k].getTranslation() - frames[l].getTranslation()).norm();
   // the gap's rounding is below 1e-12 of the numbers involved
   return centres - a.a_max - b.a_max - 1e-12 * (1.0 + centres + a.a_max + b.a_max);
+}
+
+double ArmWorld::group_gap(std::size_t g, const double* centres) const {
+  const auto [p, q] = groups_[g];
+  const double ra = parts_.bodies()[p].a_max, rb = parts_.bodies()[q].a_max;
+  const double dx = centres[3 * p] - centres[3 * q], dy = centres[3 * p + 1] - centres[3 * q + 1],
+               dz = centres[3 * p + 2] - centres[3 * q + 2];
+  const double between = std::sqrt(dx * dx + dy * dy + dz * dz);
+  return between - ra - rb - 1e-12 * (1.0 + between + ra + rb);
 }
 
 bool ArmWorld::pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames) {

@@ -23,6 +23,13 @@ namespace kcplan {
 /// collide. A pair is first tested by the bodies' bounding balls (centre, largest
 /// semi-axis): balls apart, bodies apart; only pairs whose balls meet go to coal's GJK.
 ///
+/// Parts: the bodies on one joint of the chain move as one rigid body; `parts()` is the
+/// chain with one ball per such joint that encloses its bodies (part_of(k) says which), and
+/// the self pairs fall into groups of one part pair each (`groups()`; `runs()` are the
+/// stretches of consecutive pairs of one group). A group's ball gap bounds the distance of
+/// each of its pairs from below, and the parts' speed bounds bound the bodies': the
+/// certifier decides whole groups that are far apart without looking at their pairs.
+///
 /// Contract: a configuration has chain().dof() finite numbers (std::invalid_argument
 /// otherwise; limits are the certifier's business). Distances of safe_* queries are
 /// reduced by the scene's error allowance (World::safe) and never overestimate.
@@ -34,7 +41,23 @@ class ArmWorld {
   ArmWorld(const ArmWorld&) = delete;
   ArmWorld& operator=(const ArmWorld&) = delete;
 
+  /// Consecutive self pairs [begin, end) of one group.
+  struct Run {
+    std::size_t begin, end;
+    int group;
+  };
+
   const Chain& chain() const { return chain_; }
+  const Chain& parts() const { return parts_; }
+  int part_of(std::size_t k) const { return part_of_[k]; }
+  /// The part pairs (p, q) of the self pairs, each once; pairs()[m] is in group_of(m).
+  const std::vector<std::array<int, 2>>& groups() const { return groups_; }
+  int group_of(std::size_t m) const { return group_of_[m]; }
+  const std::vector<Run>& runs() const { return runs_; }
+  /// A certain lower bound of the distance between any body of part p and any body of
+  /// part q, (p, q) = groups()[g], from the parts' centres (3 numbers per part, world
+  /// frame): the balls' gap less rounding (<= 0: nothing known).
+  double group_gap(std::size_t g, const double* centres) const;
   World& scene() { return *scene_; }
   const std::vector<std::array<int, 2>>& pairs() const { return pairs_; }
 
@@ -74,7 +97,11 @@ class ArmWorld {
   bool pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames);
 
   Chain chain_;
-  std::vector<std::array<int, 2>> pairs_;
+  std::vector<int> part_of_;  // before parts_: parts_ is built from it
+  Chain parts_;
+  std::vector<std::array<int, 2>> pairs_, groups_;
+  std::vector<int> group_of_;
+  std::vector<Run> runs_;
   std::unique_ptr<World> scene_;
   std::vector<std::shared_ptr<coal::CollisionGeometry>> shapes_;
   std::vector<coal::Transform3s> joints_, frames_;

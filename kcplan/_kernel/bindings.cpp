@@ -332,13 +332,14 @@ NB_MODULE(_core, m) {
       .def(
           "__init__",
           [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
-             std::size_t cache_entries, bool probes) {
+             std::size_t cache_entries, bool probes, bool part_balls) {
             kcplan::ArmCertifierOptions o;
             o.max_guards = max_guards, o.cache_entries = cache_entries, o.probes = probes;
+            o.part_balls = part_balls;
             new (self) kcplan::ArmCertifier(world, o);
           },
           "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
-          nb::keep_alive<1, 2>())
+          "part_balls"_a = true, nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();
@@ -355,6 +356,7 @@ NB_MODULE(_core, m) {
         nb::dict d = certifier_counters(c.counters);
         d["refined_pairs"] = c.refined_pairs;
         d["refined_bodies"] = c.refined_bodies;
+        d["skipped_groups"] = c.skipped_groups;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {
@@ -364,5 +366,6 @@ NB_MODULE(_core, m) {
       })
       .def_prop_ro("cache_size", [](const kcplan::ArmCertifier& c) { return c.cache().size(); })
       .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards)
-      .def_prop_ro("probes", &kcplan::ArmCertifier::probes);
+      .def_prop_ro("probes", &kcplan::ArmCertifier::probes)
+      .def_prop_ro("part_balls", &kcplan::ArmCertifier::part_balls);
 }

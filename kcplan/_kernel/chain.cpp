@@ -71,7 +71,22 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
     }
     bodies_.push_back(body);
   }
+  bound_speeds();
+}
 
+Chain Chain::with_bodies(std::vector<ChainBody> bodies) const {
+  Chain out;
+  out.joints_ = joints_, out.lower_ = lower_, out.upper_ = upper_;
+  out.bodies_ = std::move(bodies);
+  for (const ChainBody& b : out.bodies_)
+    if (b.joint < 0 || b.joint > static_cast<int>(joints_.size()) || !(b.a_max > 0.0))
+      throw std::invalid_argument("chain: a body's joint is out of range or its size not positive");
+  out.bound_speeds();
+  return out;
+}
+
+void Chain::bound_speeds() {
+  const std::size_t n = joints_.size(), dof = lower_.size(), count = bodies_.size();
   // the speed bounds (kcplan/arm/bounds.py chain_speeds): how far joint i's origin lies
   // from its parent's over the whole joint box
   std::vector<double> hop(n + 1, 0.0);
@@ -119,6 +134,11 @@ void Chain::joint_frames(const double* q, std::vector<coal::Transform3s>& out) c
 void Chain::body_frames(const double* q, std::vector<coal::Transform3s>& joints,
                         std::vector<coal::Transform3s>& out) const {
   joint_frames(q, joints);
+  place_bodies(joints, out);
+}
+
+void Chain::place_bodies(const std::vector<coal::Transform3s>& joints,
+                         std::vector<coal::Transform3s>& out) const {
   out.resize(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k)
     out[k] = joints[bodies_[k].joint] * bodies_[k].placement;

@@ -93,7 +93,18 @@ class Chain {
   /// them count (kcplan/arm/bounds.py relative_speeds). Row m for pairs[m], dof per row.
   std::vector<double> relative_speeds(const std::vector<std::array<int, 2>>& pairs) const;
 
+  /// The same joints and limits with other bodies (each `placement` in its joint's
+  /// frame), and their speed bounds: what ArmWorld::parts() is made of.
+  Chain with_bodies(std::vector<ChainBody> bodies) const;
+  /// Frames of the bodies, given the joint frames of one configuration (joint_frames).
+  void place_bodies(const std::vector<coal::Transform3s>& joints,
+                    std::vector<coal::Transform3s>& out) const;
+
  private:
+  Chain() = default;
+  /// rho_ and carries_ of bodies_ (the constructor's speed bounds).
+  void bound_speeds();
+
   std::vector<ChainJoint> joints_;  // joints 1..n; joints_[i - 1] is joint i
   std::vector<ChainBody> bodies_;
   std::vector<double> lower_, upper_, rho_;

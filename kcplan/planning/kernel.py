@@ -148,11 +148,18 @@ class KernelArmCertifier:
         certifier's queries show in ``world.counters``.
     max_guards, cache_entries, probes
         As for :class:`~kcplan.planning.arm_certifier.ArmEdgeCertifier`.
+    part_balls : bool
+        Decide a group of self pairs (two links' bodies) at once when balls around the
+        links' bodies show that none of them can limit a guard's radius, and ask a pair's
+        bounding-ball gap only when its group is near (``ArmCertifier``; the radii, and so
+        the decisions, are those without it). False: every pair at every guard.
 
     Notes
     -----
-    ``counters`` adds ``refined_pairs``: self pairs whose bounding balls' gap limited a
-    guard's radius, so that coal measured their distance. Not thread-safe.
+    ``counters`` adds ``refined_pairs`` (self pairs whose bounding balls' gap limited a
+    guard's radius, so that coal measured their distance), ``refined_bodies`` and
+    ``skipped_groups`` (groups of pairs a radius decided by their links' balls). Not
+    thread-safe.
     """
 
     backend = "kernel"
@@ -160,12 +167,17 @@ class KernelArmCertifier:
     fallback = "bisection"
 
     def __init__(
-        self, world, max_guards: int = 256, cache_entries: int = 200_000, probes: bool = True
+        self,
+        world,
+        max_guards: int = 256,
+        cache_entries: int = 200_000,
+        probes: bool = True,
+        part_balls: bool = True,
     ):
         self.world = world
         self.n = world.arm.dof
         self.compiled = _CompiledArmCertifier(
-            world.kernel, int(max_guards), int(cache_entries), bool(probes)
+            world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls)
         )
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:

@@ -56,6 +56,7 @@ PLANNER_NAMES = (
     "kc-prm-paper",
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",
+    "kc-rrtconnect-noparts",
     "kc-prm-noprobe",
     "kc-rrtconnect-py",
     "kc-prm-py",

@@ -72,6 +72,7 @@ class PlannerSpec:
     backend: str = "kernel"
     probes: int = DEFAULT_PROBES  # collision probes per edge before its guards (kc)
     joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
+    part_balls: bool = True  # arms (kc, kernel): far groups of self pairs decided at once
 
     @property
     def kc(self) -> bool:
@@ -117,6 +118,13 @@ PLANNERS: dict[str, PlannerSpec] = {
         _KC,
         description="ablation: kc-rrtconnect without collision probes before the guards",
         probes=0,
+    ),
+    "kc-rrtconnect-noparts": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation (arms): kc-rrtconnect looking at every self pair at every "
+        "guard, without the links' balls that decide far groups of pairs at once",
+        part_balls=False,
     ),
     "kc-prm-noprobe": PlannerSpec(
         og.PRM,
@@ -530,7 +538,9 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     validator = None
     n = arm.dof
     if spec.kc:
-        validator = KCMotionValidator(si, arm, world, backend=spec.backend, probes=spec.probes)
+        validator = KCMotionValidator(
+            si, arm, world, backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls
+        )
         si.setMotionValidator(validator)
         state_valid = validator.state_valid
     elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand

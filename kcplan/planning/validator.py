@@ -96,6 +96,10 @@ class KCMotionValidator(ob.MotionValidator):
         on python-fcl; the default, and the only choice, for a world written in Python).
         Both decide every edge by the same steps; neither accepts an edge to a pose that
         is not finite.
+    part_balls : bool
+        Arms, compiled: decide the self pairs of two links far apart at once by balls
+        around the links' bodies (``ArmCertifier``'s ``part_balls``; the same decisions,
+        fewer pairs looked at). False is the ablation.
     """
 
     def __init__(
@@ -111,12 +115,15 @@ class KCMotionValidator(ob.MotionValidator):
         sweep_test: bool | None = None,
         backend: str | None = None,
         probes: int = DEFAULT_PROBES,
+        part_balls: bool = True,
     ):
         super().__init__(si)
         self.space = si.getStateSpace()  # not si itself: see the module docstring
         self.error: Exception | None = None
         if isinstance(world, ArmWorld):
-            self._init_arm(robot, world, certificates, fallback, max_guards, backend, probes)
+            self._init_arm(
+                robot, world, certificates, fallback, max_guards, backend, probes, part_balls
+            )
             return
         max_guards = 64 if max_guards is None else max_guards
         robot = Robot.of(robot)
@@ -155,7 +162,9 @@ class KCMotionValidator(ob.MotionValidator):
             if fallback != "discrete":  # the discrete fallback needs OMPL's resolution
                 self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
 
-    def _init_arm(self, arm, world, certificates, fallback, max_guards, backend, probes) -> None:
+    def _init_arm(
+        self, arm, world, certificates, fallback, max_guards, backend, probes, part_balls
+    ) -> None:
         if arm is not world.arm:
             raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
         backend = "kernel" if backend is None else backend
@@ -168,7 +177,9 @@ class KCMotionValidator(ob.MotionValidator):
             )
         max_guards = 256 if max_guards is None else max_guards
         if backend == "kernel":
-            self.certifier = KernelArmCertifier(world, max_guards, probes=probes > 0)
+            self.certifier = KernelArmCertifier(
+                world, max_guards, probes=probes > 0, part_balls=part_balls
+            )
             # the hot path: one call into the kernel with the joint vector(s)
             self.state_valid = self._valid_kernel_arm
             self.checkMotion = self._check_kernel_arm
