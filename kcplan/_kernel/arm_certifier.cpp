@@ -29,6 +29,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   dq_.resize(n_);
   growth_.resize(speed_.size() * n_);
   pair_growth_.resize(pair_speed_.size());
+  pair_edge_.assign(pair_speed_.size(), 0);
   const std::vector<bool>& C = chain_.carries();
   for (const auto& [k, l] : world.pairs())
     for (int j = 0; j < n_; ++j) {
@@ -64,10 +65,39 @@ void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double
   }
   const std::size_t m = k - bodies;
   const auto [a, b] = world_.pairs()[m];
+  pair_terms(m);
   for (int j = 0; j < n_; ++j)
     A += dq_[j] * (only_first_[m * n_ + j] * guard.levers[a * n_ + j] +
                    only_second_[m * n_ + j] * guard.levers[b * n_ + j]);
   Q = pair_growth_[m];
+}
+
+void ArmCertifier::pair_terms(std::size_t m) const {
+  if (pair_edge_[m] == edge_) return;
+  pair_edge_[m] = edge_;
+  const std::size_t dof = n_;
+  const auto [a, b] = world_.pairs()[m];
+  double v = 0.0, Q = 0.0;
+  for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * dq_[j];
+  for (std::size_t j = 0; j < dof; ++j)
+    Q += only_first_[m * dof + j] * growth_[a * dof + j] +
+         only_second_[m * dof + j] * growth_[b * dof + j];
+  pair_speed_[m] = v, pair_growth_[m] = Q;
+}
+
+template <class Frames>
+double ArmCertifier::run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames) {
+  const int g = run.group, k = run.body, q = world_.groups()[g][1];
+  double v = 0.0, A = 0.0, Q = 0.0;
+  for (int j = 0; j < n_; ++j) {
+    const double first = group_first_[g * n_ + j], second = group_second_[g * n_ + j];
+    v += dq_[j] * (first * rho_[k * n_ + j] + second * world_.parts().point_speeds()[q * n_ + j]);
+    A += dq_[j] * (first * guard.levers[k * n_ + j] + second * guard.part_levers[q * n_ + j]);
+    Q += first * growth_[k * n_ + j] + second * part_growth_[q * n_ + j];
+  }
+  if (!(v > 0.0)) return std::numeric_limits<double>::infinity();
+  const double gap = world_.body_part_gap(k, frames(), q, guard.part_centres.data());
+  return reach(std::max(gap, 0.0), v, A, Q);
 }
 
 double ArmCertifier::group_reach(const ArmGuard& guard, std::size_t g) const {
@@ -85,6 +115,7 @@ double ArmCertifier::group_reach(const ArmGuard& guard, std::size_t g) const {
 template <class Frames>
 void ArmCertifier::pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
                                Frames& frames) {
+  pair_terms(m);
   const double v = pair_speed_[m];
   if (!(v > 0.0)) return;
   if (!guard.pair_known[m]) {
@@ -162,10 +193,9 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   const std::vector<coal::Transform3s>& frames = world_.place(q);
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
   const Chain& parts = world_.parts();
-  parts.place_bodies(world_.joint_frames(), part_frames_);
   g.part_levers.resize(parts.bodies().size() * n_);
-  parts.levers(world_.joint_frames(), part_frames_, g.part_levers.data());
-  for (const coal::Transform3s& f : part_frames_)
+  parts.levers(world_.joint_frames(), world_.part_frames(), g.part_levers.data());
+  for (const coal::Transform3s& f : world_.part_frames())
     for (int i = 0; i < 3; ++i) g.part_centres.push_back(f.getTranslation()[i]);
   if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2)
     double A, Q;
@@ -236,6 +266,7 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
       ++skipped_groups;
       continue;
     }
+    if (run_reach(guard, run, frames) >= r) continue;  // the body against the other part
     for (std::size_t m = run.begin; m < run.end; ++m) pair_radius(guard, m, enough, r, frames);
   }
   return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
@@ -263,20 +294,8 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * dq_[j];
     speed_[k] = v;
   }
-  for (std::size_t m = 0; m < pair_speed_.size(); ++m) {
-    double v = 0.0;
-    for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * dq_[j];
-    pair_speed_[m] = v;
-  }
   chain_.lever_growth(dq_.data(), growth_.data());
-  for (std::size_t m = 0; m < pair_growth_.size(); ++m) {
-    const auto [a, b] = world_.pairs()[m];
-    double Q = 0.0;
-    for (std::size_t j = 0; j < dof; ++j)
-      Q += only_first_[m * dof + j] * growth_[a * dof + j] +
-           only_second_[m * dof + j] * growth_[b * dof + j];
-    pair_growth_[m] = Q;
-  }
+  ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_terms)
   if (part_balls_) {
     const Chain& parts = world_.parts();
     for (std::size_t g = 0; g < group_speed_.size(); ++g) {

@@ -77,8 +77,11 @@ struct ArmCertifierOptions {
 /// distance is asked only when its balls' gap would limit a radius: the radius is then
 /// exactly the one of exact distances. With part_balls, a group of pairs whose parts'
 /// balls (ArmWorld::parts) give every pair of it at least the radius the others allow is
-/// not looked at: its pairs could not lower that radius (each pair's distance is at least
-/// its group's gap, its speeds at most its parts'), so the radius is the same.
+/// not looked at, nor a run of it whose body's ball and other part's ball do: its pairs
+/// could not lower that radius (each pair's distance is at least the balls' gap, each of
+/// its speeds, levers and growth at most the balls' from the parts' speed bounds, and the
+/// radius a clearance gives grows with the clearance and shrinks with the others), so
+/// the radius is the same.
 /// Not thread-safe (the world's objects are reused).
 class ArmCertifier {
  public:
@@ -140,6 +143,9 @@ class ArmCertifier {
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
   /// The radius group g's gap gives all its pairs, for the current edge.
   double group_reach(const ArmGuard& guard, std::size_t g) const;
+  /// The same of one run's pairs: its body's ball against the other part's.
+  template <class Frames>
+  double run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames);
   /// Self pair m's part of radius(): its bound asked if not known, refined if it would
   /// hold r below min(r, enough), then r lowered to what it gives.
   /// `frames()` gives the bodies' frames at the guard (computed on first use).
@@ -149,10 +155,15 @@ class ArmCertifier {
 
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
-  std::vector<double> speed_, pair_speed_, q_, caps_, dq_, growth_, pair_growth_;
+  std::vector<double> speed_, q_, caps_, dq_, growth_;
+  /// Self pair m's speed and growth for the current edge, computed when first needed.
+  void pair_terms(std::size_t m) const;
+  mutable std::vector<double> pair_speed_, pair_growth_;
+  mutable std::vector<std::uint64_t> pair_edge_;  // the edge pair m's terms are of
+  std::uint64_t edge_ = 0;
   std::vector<double> rho_groups_, group_speed_, group_growth_, part_growth_, group_t_;
   std::vector<double> group_first_, group_second_;  // groups x dof: joint carries one part only
-  std::vector<coal::Transform3s> joints_, frames_, part_frames_;  // scratch
+  std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
   std::vector<std::pair<double, double>> pending_;
 };
 

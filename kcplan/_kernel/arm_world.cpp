@@ -81,8 +81,9 @@ ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pa
     const auto it = std::find(groups_.begin(), groups_.end(), group);
     group_of_.push_back(static_cast<int>(it - groups_.begin()));
     if (it == groups_.end()) groups_.push_back(group);
-    if (runs_.empty() || runs_.back().group != group_of_.back())
-      runs_.push_back({m, m + 1, group_of_.back()});
+    if (runs_.empty() || runs_.back().group != group_of_.back() ||
+        pairs[runs_.back().begin][0] != pairs[m][0])  // one first body per run
+      runs_.push_back({m, m + 1, group_of_.back(), pairs[m][0]});
     else
       runs_.back().end = m + 1;
   }
@@ -100,8 +101,26 @@ const std::vector<coal::Transform3s>& ArmWorld::place(const double* q) {
       throw std::invalid_argument("state: expected " + std::to_string(chain_.dof()) +
                                   " finite joint values");
   chain_.body_frames(q, joints_, frames_);
+  parts_.place_bodies(joints_, part_frames_);
   scene_->place_bodies(frames_.data());
   return frames_;
+}
+
+void ArmWorld::scene_clearances(double* out, const double* caps) {
+  if (caps == nullptr) return scene_->bodies_safe_clearances(out);
+  ++scene_->counters.distance_queries;
+  part_caps_.assign(parts_.bodies().size(), 0.0);
+  for (std::size_t k = 0; k < part_of_.size(); ++k)
+    part_caps_[part_of_[k]] = std::max(part_caps_[part_of_[k]], caps[k]);
+  for (std::size_t p = 0; p < part_caps_.size(); ++p) {
+    const coal::Vec3s& c = part_frames_[p].getTranslation();
+    ++part_queries;
+    const double d = scene_->ball_safe_clearance({c[0], c[1], c[2]}, parts_.bodies()[p].a_max,
+                                                 part_caps_[p]);
+    part_caps_[p] = d >= part_caps_[p] ? 1.0 : 0.0;  // now: whether the part is far
+  }
+  for (std::size_t k = 0; k < part_of_.size(); ++k)
+    out[k] = part_caps_[part_of_[k]] > 0.0 ? caps[k] : scene_->capped_clearance(k, caps[k]);
 }
 
 double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
@@ -117,6 +136,16 @@ double ArmWorld::group_gap(std::size_t g, const double* centres) const {
   const double ra = parts_.bodies()[p].a_max, rb = parts_.bodies()[q].a_max;
   const double dx = centres[3 * p] - centres[3 * q], dy = centres[3 * p + 1] - centres[3 * q + 1],
                dz = centres[3 * p + 2] - centres[3 * q + 2];
+  const double between = std::sqrt(dx * dx + dy * dy + dz * dz);
+  return between - ra - rb - 1e-12 * (1.0 + between + ra + rb);
+}
+
+double ArmWorld::body_part_gap(std::size_t k, const std::vector<coal::Transform3s>& frames, int q,
+                               const double* centres) const {
+  const double ra = chain_.bodies()[k].a_max, rb = parts_.bodies()[q].a_max;
+  const coal::Vec3s& c = frames[k].getTranslation();
+  const double dx = c[0] - centres[3 * q], dy = c[1] - centres[3 * q + 1],
+               dz = c[2] - centres[3 * q + 2];
   const double between = std::sqrt(dx * dx + dy * dy + dz * dz);
   return between - ra - rb - 1e-12 * (1.0 + between + ra + rb);
 }
@@ -151,9 +180,28 @@ double ArmWorld::pair_clearance(std::size_t m, const std::vector<coal::Transform
 
 bool ArmWorld::in_collision(const double* q) {
   const std::vector<coal::Transform3s>& frames = place(q);
-  if (scene_->bodies_collide()) return true;
-  for (std::size_t m = 0; m < pairs_.size(); ++m)
-    if (pair_collides(m, frames)) return true;
+  // the scene: only the bodies of parts whose ball touches it
+  ++scene_->counters.collision_queries;
+  part_caps_.assign(parts_.bodies().size(), -1.0);  // per part: -1 not asked, 0 apart, 1 touches
+  for (std::size_t k = 0; k < part_of_.size(); ++k) {
+    double& touches = part_caps_[part_of_[k]];
+    if (touches < 0.0) {
+      const coal::Vec3s& c = part_frames_[part_of_[k]].getTranslation();
+      ++part_queries;
+      touches = scene_->ball_touches({c[0], c[1], c[2]}, parts_.bodies()[part_of_[k]].a_max);
+    }
+    if (touches > 0.0 && scene_->body_collides(k)) return true;
+  }
+  centres_.clear();
+  for (const coal::Transform3s& f : part_frames_)
+    for (int i = 0; i < 3; ++i) centres_.push_back(f.getTranslation()[i]);
+  for (const Run& run : runs_) {
+    if (group_gap(run.group, centres_.data()) > 0.0) continue;  // the parts' balls are apart
+    if (body_part_gap(run.body, frames, groups_[run.group][1], centres_.data()) > 0.0)
+      continue;  // the body's ball and the other part's are apart
+    for (std::size_t m = run.begin; m < run.end; ++m)
+      if (pair_collides(m, frames)) return true;
+  }
   return false;
 }
 

@@ -26,9 +26,12 @@ namespace kcplan {
 /// Parts: the bodies on one joint of the chain move as one rigid body; `parts()` is the
 /// chain with one ball per such joint that encloses its bodies (part_of(k) says which), and
 /// the self pairs fall into groups of one part pair each (`groups()`; `runs()` are the
-/// stretches of consecutive pairs of one group). A group's ball gap bounds the distance of
-/// each of its pairs from below, and the parts' speed bounds bound the bodies': the
-/// certifier decides whole groups that are far apart without looking at their pairs.
+/// stretches of consecutive pairs of one group and one first body). A group's ball gap
+/// bounds the distance of each of its pairs from below, a run's (its body's ball against
+/// the other part's) each of its pairs', and the parts' speed bounds bound the bodies':
+/// queries and the certifier decide whole groups and runs that are far apart without
+/// looking at their pairs, and a part's bodies only when the part's ball is near the
+/// scene.
 ///
 /// Contract: a configuration has chain().dof() finite numbers (std::invalid_argument
 /// otherwise; limits are the certifier's business). Distances of safe_* queries are
@@ -41,10 +44,11 @@ class ArmWorld {
   ArmWorld(const ArmWorld&) = delete;
   ArmWorld& operator=(const ArmWorld&) = delete;
 
-  /// Consecutive self pairs [begin, end) of one group.
+  /// Consecutive self pairs [begin, end) of one group with one first body, `body`: that
+  /// body against bodies of the group's second part.
   struct Run {
     std::size_t begin, end;
-    int group;
+    int group, body;
   };
 
   const Chain& chain() const { return chain_; }
@@ -58,6 +62,9 @@ class ArmWorld {
   /// part q, (p, q) = groups()[g], from the parts' centres (3 numbers per part, world
   /// frame): the balls' gap less rounding (<= 0: nothing known).
   double group_gap(std::size_t g, const double* centres) const;
+  /// The same between body k, at `frames[k]`, and part q: its ball's gap to the part's.
+  double body_part_gap(std::size_t k, const std::vector<coal::Transform3s>& frames, int q,
+                       const double* centres) const;
   World& scene() { return *scene_; }
   const std::vector<std::array<int, 2>>& pairs() const { return pairs_; }
 
@@ -74,11 +81,13 @@ class ArmWorld {
   const std::vector<coal::Transform3s>& place(const double* q);
   /// The joints' frames of the last place().
   const std::vector<coal::Transform3s>& joint_frames() const { return joints_; }
+  /// The parts' frames of the last place() (their balls' centres).
+  const std::vector<coal::Transform3s>& part_frames() const { return part_frames_; }
   /// Certain clearance of each body to the obstacles, as placed (one distance query);
-  /// with `caps`, min(clearance, caps[k]) (World::bodies_safe_clearances).
-  void scene_clearances(double* out, const double* caps = nullptr) {
-    scene_->bodies_safe_clearances(out, caps);
-  }
+  /// with `caps`, min(clearance, caps[k]) (World::bodies_safe_clearances), each part's
+  /// ball asked first: a ball clear by the largest cap of its bodies holds each of them
+  /// clear by its cap, and only the bodies of the parts nearer than that are asked.
+  void scene_clearances(double* out, const double* caps = nullptr);
   /// min(cap, body k's certain clearance to the obstacles) with the bodies at `frames`.
   double body_clearance(std::size_t k, const std::vector<coal::Transform3s>& frames, double cap) {
     return scene_->body_safe_clearance(k, frames[k], cap);
@@ -92,6 +101,7 @@ class ArmWorld {
 
   WorldCounters& counters() { return scene_->counters; }
   std::int64_t pair_queries = 0;  ///< self pairs that went to GJK
+  std::int64_t part_queries = 0;  ///< parts' balls asked for their scene clearance
 
  private:
   bool pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames);
@@ -104,7 +114,8 @@ class ArmWorld {
   std::vector<Run> runs_;
   std::unique_ptr<World> scene_;
   std::vector<std::shared_ptr<coal::CollisionGeometry>> shapes_;
-  std::vector<coal::Transform3s> joints_, frames_;
+  std::vector<coal::Transform3s> joints_, frames_, part_frames_;
+  std::vector<double> part_caps_, centres_;
   std::vector<coal::Vec3s> guesses_;  // per pair: where its last GJK ended
   std::vector<coal::support_func_guess_t> hints_;
 };

@@ -320,12 +320,13 @@ NB_MODULE(_core, m) {
       .def_prop_ro("counters", [](kcplan::ArmWorld& w) {
         nb::dict d = world_counters(w.scene());
         d["pair_queries"] = w.pair_queries;
+        d["part_queries"] = w.part_queries;
         return d;
       })
       .def("reset_counters", [](kcplan::ArmWorld& w) {
         w.scene().counters = kcplan::WorldCounters{};
         std::fill(w.scene().body_query_counts.begin(), w.scene().body_query_counts.end(), 0);
-        w.pair_queries = 0;
+        w.pair_queries = 0, w.part_queries = 0;
       });
 
   nb::class_<kcplan::ArmCertifier>(m, "ArmCertifier")

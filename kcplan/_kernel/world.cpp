@@ -554,17 +554,47 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
   return true;
 }
 
+bool World::body_collides(std::size_t k) {
+  if (objects_.empty()) return false;
+  count_body(k);
+  return collides(*bodies_[k], k);
+}
+
 bool World::ball_collides(const std::array<double, 3>& centre, double radius) {
+  ++counters.collision_queries;
+  return ball_touches(centre, radius);
+}
+
+bool World::ball_touches(const std::array<double, 3>& centre, double radius) {
   require_finite(centre.data(), 3, "centre");
   if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
   if (!finalized_) finalize();
-  ++counters.collision_queries;
   if (objects_.empty()) return false;
   coal::CollisionObject ball(std::make_shared<coal::Sphere>(radius),
                              coal::Transform3s(coal::Matrix3s::Identity(),
                                                Vec3s(centre[0], centre[1], centre[2])));
   ball.computeAABB();
   return collides(ball, core_shape());
+}
+
+double World::ball_safe_clearance(const std::array<double, 3>& centre, double radius,
+                                  double cap) {
+  require_finite(centre.data(), 3, "centre");
+  if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
+  if (!finalized_) finalize();
+  if (objects_.empty()) return std::numeric_limits<double>::infinity();
+  coal::CollisionObject ball(std::make_shared<coal::Sphere>(radius),
+                             coal::Transform3s(coal::Matrix3s::Identity(),
+                                               Vec3s(centre[0], centre[1], centre[2])));
+  ball.computeAABB();
+  // as capped_clearance: a raw distance of at least (cap + atol) / (1 - rtol) is certainly
+  // at least cap
+  const double raw = cap < std::numeric_limits<double>::infinity()
+                         ? (cap + atol_) / (1.0 - rtol_)
+                         : std::numeric_limits<double>::infinity();
+  DistanceNear near(this, &ball, core_shape(), raw);
+  manager_->distance(&ball, &near);
+  return near.best >= raw ? cap : safe(near.best);
 }
 
 bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,

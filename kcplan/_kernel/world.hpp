@@ -136,8 +136,20 @@ class World {
   /// coal distance certainly is (never an overestimate).
   double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
 
+  /// Whether body k as placed touches an obstacle (one body's part of bodies_collide;
+  /// counted as a body query, not as a collision query).
+  bool body_collides(std::size_t k);
+  /// min(cap, the certain clearance) of body k as placed (one body's part of
+  /// bodies_safe_clearances; counted as a body query, not as a distance query).
+  double capped_clearance(std::size_t k, double cap);
+
   /// Whether the ball of `radius` about `centre` (z = 0 in 2D) meets an obstacle.
   bool ball_collides(const std::array<double, 3>& centre, double radius);
+  /// ball_collides, not counted: whether anything inside the ball may touch an obstacle.
+  bool ball_touches(const std::array<double, 3>& centre, double radius);
+  /// min(cap, the certain clearance) of the ball of `radius` about `centre` (not
+  /// counted): a lower bound of the clearance of anything inside the ball.
+  double ball_safe_clearance(const std::array<double, 3>& centre, double radius, double cap);
   /// Whether the capsule of `radius` about the segment a -> b meets an obstacle.
   bool sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,
                            double radius);
@@ -199,7 +211,6 @@ class World {
                                                bool measure) const;
   std::size_t core_shape() const { return bodies_.size(); }
   void count_body(std::size_t k);
-  double capped_clearance(std::size_t k, double cap);
 
   Robot robot_;
   int dimension_;
