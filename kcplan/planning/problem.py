@@ -122,8 +122,9 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect-noparts": PlannerSpec(
         og.RRTConnect,
         _KC,
-        description="ablation (arms): kc-rrtconnect looking at every self pair at every "
-        "guard, without the links' balls that decide far groups of pairs at once",
+        description="ablation (arms): kc-rrtconnect whose guard radii look at every self "
+        "pair, without the links' balls that decide far groups of pairs at once (the "
+        "world's state checks, every planner's, use those balls either way)",
         part_balls=False,
     ),
     "kc-prm-noprobe": PlannerSpec(
