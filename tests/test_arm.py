@@ -130,6 +130,12 @@ def test_a_group_in_another_order_is_the_state_order(tmp_path, monkeypatch):
             {"fixed": {"panda_joint7": math.inf}},
             r"fixed.panda_joint7: expected a finite",
         ),
+        (
+            GROUP[:6],  # joint 7 turns within [-2.9671, 2.9671]
+            {"fixed": {"panda_joint7": 3.5}},
+            r"fixed.panda_joint7: expected a value within the joint's limits "
+            r"\[-2.9671, 2.9671\], got 3.5$",
+        ),
         (GROUP, {"srdf": "missing.srdf"}, r"missing.srdf: srdf: expected an SRDF file, found none"),
     ],
 )

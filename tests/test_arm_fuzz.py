@@ -193,6 +193,10 @@ def test_a_urdf_without_collision_geometry_is_one_line(tmp_path, monkeypatch):
         ({"joints": GROUP[:6], "fixed": {"panda_joint7": -math.inf}}, r"robot.fixed.panda_joint7"),
         ({"joints": GROUP[:6], "fixed": {"panda_joint7": "far"}}, r"robot.fixed.panda_joint7"),
         ({"joints": GROUP[:6], "fixed": {"panda_joint7": None}}, r"robot.fixed.panda_joint7"),
+        (
+            {"joints": GROUP[:6], "fixed": {"panda_joint7": -3.0}},
+            r"fixed.panda_joint7: expected a value within the joint's limits",
+        ),
     ],
 )
 def test_bad_groups_and_fixed_values_in_a_scenario_are_one_line(tmp_path, monkeypatch, robot,

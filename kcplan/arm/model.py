@@ -273,6 +273,12 @@ def load_arm(
                 f"{source}: fixed.{name}: expected a finite value of a 1-DOF joint, "
                 f"got {fixed[name]!r}"
             )
+        low, high = full.lowerPositionLimit[joint.idx_q], full.upperPositionLimit[joint.idx_q]
+        if not low <= value <= high:  # the covers and bounds hold within the limits only
+            raise ArmError(
+                f"{source}: fixed.{name}: expected a value within the joint's limits "
+                f"[{low:g}, {high:g}], got {value:g}"
+            )
         q_fixed[joint.idx_q] = value
     for name in full.names[1:]:
         joint = full.joints[full.getJointId(name)]
