@@ -11,7 +11,15 @@ from conftest import AXES_A, AXES_B, FRAME_A, FRAME_B, arm_obstacles, panda_arm
 from scipy.spatial.transform import Rotation
 
 from kcplan.arm import ArmWorld
-from kcplan.arm.bounds import carries, lever_growth, levers, point_speeds, relative_speeds
+from kcplan.arm.bounds import (
+    carries,
+    first_order_speeds,
+    lever_growth,
+    levers,
+    point_accelerations,
+    point_speeds,
+    relative_speeds,
+)
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
@@ -104,6 +112,37 @@ def test_the_local_bound_holds_along_random_edges(panda, states):
                 assert np.linalg.norm(moved, axis=1).max() <= A[k] * t + Q[k] * t * t / 2 + 1e-12
             tighter += (A * 0.02 + Q * 0.0002 < rho @ dq * 0.02).sum()
     assert tighter > 0.5 * 20 * len(panda.bodies)
+
+
+def test_first_order_bounds_hold_and_are_the_kernels(panda, world, states):
+    """Within t of a guard no sampled surface point moves farther than A1 t + M t^2 / 2
+    (the body's twist there and its largest acceleration, kcplan.arm.bounds), on either
+    side; the kernel computes the same A1 and M; and A1 is well below the levers' A."""
+    u = np.random.default_rng(4).normal(size=(200, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    chain, ratios, worst = world.kernel.chain, [], 0.0
+    for q1, q2 in zip(states[40:60], states[41:61], strict=True):
+        step, m = q2 - q1, 0.4
+        qm = q1 + m * step
+        A1, M = first_order_speeds(panda, qm, step), point_accelerations(panda, np.abs(step))
+        got = chain.first_order_speeds(qm.tolist(), step.tolist())
+        np.testing.assert_allclose(got, A1, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(chain.point_accelerations(np.abs(step).tolist()), M, rtol=1e-9)
+        at_m = body_frames(panda, qm)
+        for t in (0.003, 0.05, 0.2, 0.4):
+            for s in (m - t, m + t):
+                frames = body_frames(panda, q1 + s * step)
+                for k, body in enumerate(panda.bodies):
+                    local = u * body.semi_axes
+                    moved = (local @ frames[k][:3, :3].T + frames[k][:3, 3]) - (
+                        local @ at_m[k][:3, :3].T + at_m[k][:3, 3]
+                    )
+                    bound = A1[k] * t + M[k] * t * t / 2
+                    worst = max(worst, np.linalg.norm(moved, axis=1).max() - bound)
+        moving = A1 > 0
+        ratios.extend(A1[moving] / (levers(panda, qm) @ np.abs(step))[moving])
+    assert worst <= 1e-12
+    assert np.median(ratios) < 0.8  # the twist's joint terms partly cancel
 
 
 def test_kernel_and_python_agree_on_every_state(world, states):

@@ -17,6 +17,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       max_guards_(options.max_guards),
       probes_(options.probes),
       part_balls_(options.part_balls),
+      first_order_(options.first_order),
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
       rho_pairs_(world.chain().relative_speeds(world.pairs())),
@@ -46,12 +47,25 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   group_growth_.resize(world.groups().size());
   group_t_.resize(world.groups().size());
   part_growth_.resize(world.parts().bodies().size() * n_);
+  step_.resize(n_);
+  accel_.resize(speed_.size());
+  first_.resize(speed_.size());
+}
+
+double ArmCertifier::root(double d, double A, double Q) {
+  return 2.0 * d / (A + std::sqrt(A * A + 2.0 * Q * d));  // the stable form
 }
 
 double ArmCertifier::reach(double d, double v, double A, double Q) {
   if (!(v > 0.0)) return std::numeric_limits<double>::infinity();  // it does not move
-  const double root = 2.0 * d / (A + std::sqrt(A * A + 2.0 * Q * d));  // of A t + Q t^2 / 2 = d
-  return std::max(d / v, root);
+  return std::max(d / v, root(d, A, Q));
+}
+
+double ArmCertifier::body_reach(const ArmGuard& guard, std::size_t k, double d) const {
+  double A, Q;
+  terms(guard, k, A, Q);
+  const double t = reach(d, speed_[k], A, Q);
+  return first_order_ ? std::max(t, root(d, first_[k], accel_[k])) : t;
 }
 
 void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const {
@@ -192,16 +206,24 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   g.pair_known.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
+  if (first_order_) {
+    g.joints = world_.joint_frames();
+    g.centres.reserve(3 * bodies);
+    for (const coal::Transform3s& f : frames)
+      for (int i = 0; i < 3; ++i) g.centres.push_back(f.getTranslation()[i]);
+    chain_.first_order_speeds(g.joints, g.centres.data(), step_.data(), first_.data());
+  }
   const Chain& parts = world_.parts();
   g.part_levers.resize(parts.bodies().size() * n_);
   parts.levers(world_.joint_frames(), world_.part_frames(), g.part_levers.data());
   for (const coal::Transform3s& f : world_.part_frames())
     for (int i = 0; i < 3; ++i) g.part_centres.push_back(f.getTranslation()[i]);
-  if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2)
+  if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2, ...)
     double A, Q;
     for (std::size_t k = 0; k < bodies; ++k) {
       terms(g, k, A, Q);
-      const double need = std::min(enough * speed_[k], enough * (A + 0.5 * enough * Q));
+      double need = std::min(enough * speed_[k], enough * (A + 0.5 * enough * Q));
+      if (first_order_) need = std::min(need, enough * (first_[k] + 0.5 * enough * accel_[k]));
       caps_[k] = std::max(kCapSlack * need, kClearanceFloor);
     }
     world_.scene_clearances(g.scene.data(), caps_.data());
@@ -226,12 +248,11 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
 double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   if (guard.clearance <= 0.0) return 0.0;
   const std::size_t bodies = speed_.size();
-  double r = std::numeric_limits<double>::infinity(), A, Q;
+  double r = std::numeric_limits<double>::infinity();
+  if (first_order_)  // the bodies' first order at this guard, for this edge
+    chain_.first_order_speeds(guard.joints, guard.centres.data(), step_.data(), first_.data());
   for (std::size_t k = 0; k < bodies; ++k)
-    if (speed_[k] > 0.0 && guard.scene_exact[k]) {
-      terms(guard, k, A, Q);
-      r = std::min(r, reach(guard.scene[k], speed_[k], A, Q));
-    }
+    if (speed_[k] > 0.0 && guard.scene_exact[k]) r = std::min(r, body_reach(guard, k, guard.scene[k]));
   bool placed = false;
   const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
     if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
@@ -241,14 +262,13 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   // that of exact distances, or at least `enough`
   for (std::size_t k = 0; k < bodies; ++k) {
     if (!(speed_[k] > 0.0) || guard.scene_exact[k]) continue;
-    terms(guard, k, A, Q);
-    double t = reach(guard.scene[k], speed_[k], A, Q);
+    double t = body_reach(guard, k, guard.scene[k]);
     if (t < std::min(r, enough)) {
       const double cap = std::numeric_limits<double>::infinity();
       guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
       guard.scene_exact[k] = 1;
       ++refined_bodies;
-      t = reach(guard.scene[k], speed_[k], A, Q);
+      t = body_reach(guard, k, guard.scene[k]);
     }
     r = std::min(r, t);
   }
@@ -288,13 +308,14 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
   if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
   if (!state_valid(q2)) return reject(c.rejected_end_state);
   const std::size_t dof = n_;
-  for (std::size_t j = 0; j < dof; ++j) dq_[j] = std::abs(q2[j] - q1[j]);
+  for (std::size_t j = 0; j < dof; ++j) step_[j] = q2[j] - q1[j], dq_[j] = std::abs(step_[j]);
   for (std::size_t k = 0; k < speed_.size(); ++k) {
     double v = 0.0;
     for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * dq_[j];
     speed_[k] = v;
   }
   chain_.lever_growth(dq_.data(), growth_.data());
+  if (first_order_) chain_.point_accelerations(dq_.data(), accel_.data());
   ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_terms)
   if (part_balls_) {
     const Chain& parts = world_.parts();

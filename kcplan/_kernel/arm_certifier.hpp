@@ -28,6 +28,8 @@ namespace kcplan {
 struct ArmGuard {
   std::array<double, Chain::kMaxJoints> q{};
   std::vector<double> levers;        ///< Chain::levers at q: bodies x dof
+  std::vector<coal::Transform3s> joints;  ///< the joints' frames at q (first_order)
+  std::vector<double> centres;            ///< the bodies' centres at q, 3 each (first_order)
   std::vector<double> part_levers;   ///< the same of ArmWorld::parts(): parts x dof
   std::vector<double> part_centres;  ///< the parts' centres at q: 3 per part
   mutable std::vector<double> scene, pairs;
@@ -50,6 +52,10 @@ struct ArmCertifierOptions {
   /// pair's gap only when its group is near; false: every pair at every guard (the
   /// ablation; the radii are the same, kcplan/planning/arm_certifier.py decides so too).
   bool part_balls = true;
+  /// Bound a body's motion near a guard by its exact twist there as well (Chain::
+  /// first_order_speeds, Chain::point_accelerations); false: the levers alone (the
+  /// ablation).
+  bool first_order = true;
   std::size_t cache_entries = 200000;
 };
 
@@ -60,10 +66,13 @@ struct ArmCertifierOptions {
 /// approach faster than v_kl (Chain::point_speeds, Chain::relative_speeds; Schwarzer, Saha
 /// and Latombe 2005); nor, within t of a guard at s = m, farther than A t + Q t^2 / 2,
 /// with A from the levers at q(m) and Q from how fast they can grow (Chain::levers,
-/// Chain::lever_growth). A guard with clearances d_k and d_kl therefore proves the open
-/// stretch |s - m| < r free, r the smallest over bodies and pairs of
-/// max(d / v, the root t of A t + Q t^2 / 2 = d): each body stays clear of the scene and
-/// of each body it may collide with, and the covers hold the links.
+/// Chain::lever_growth), nor, for a body (first_order), farther than A1 t + M t^2 / 2 with
+/// A1 from its twist at q(m) and M its largest acceleration (Chain::first_order_speeds,
+/// Chain::point_accelerations). A guard with clearances d_k and d_kl therefore proves the
+/// open stretch |s - m| < r free, r the smallest over bodies and pairs of
+/// max(d / v, the root t of A t + Q t^2 / 2 = d, for a body that of A1 t + M t^2 / 2 = d):
+/// each body stays clear of the scene and of each body it may collide with, and the
+/// covers hold the links.
 /// kcplan/planning/arm_certifier.py has the proof in full.
 ///
 /// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
@@ -119,6 +128,7 @@ class ArmCertifier {
   int max_guards() const { return max_guards_; }
   bool probes() const { return probes_; }
   bool part_balls() const { return part_balls_; }
+  bool first_order() const { return first_order_; }
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
   CertifierCounters counters;
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
@@ -134,11 +144,15 @@ class ArmCertifier {
   ArmWorld& world_;
   const Chain& chain_;
   int n_, max_guards_;
-  bool probes_, part_balls_;
+  bool probes_, part_balls_, first_order_;
   ArmGuardCache cache_;
   /// The radius a clearance d gives to a body or pair of global speed v, lever term A
   /// and growth Q (the class docs).
   static double reach(double d, double v, double A, double Q);
+  /// The root t of A t + Q t^2 / 2 = d (inf when neither moves).
+  static double root(double d, double A, double Q);
+  /// Body k's radius from the clearance d at `guard`: reach, and the first order's root.
+  double body_reach(const ArmGuard& guard, std::size_t k, double d) const;
   /// A and Q of body k (k < bodies) or of pair k - bodies, for the current edge.
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
   /// The radius group g's gap gives all its pairs, for the current edge.
@@ -155,7 +169,8 @@ class ArmCertifier {
 
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
-  std::vector<double> speed_, q_, caps_, dq_, growth_;
+  std::vector<double> speed_, q_, caps_, dq_, growth_, step_, accel_;
+  mutable std::vector<double> first_;  // A1 of the bodies at the guard of the radius asked
   /// Self pair m's speed and growth for the current edge, computed when first needed.
   void pair_terms(std::size_t m) const;
   mutable std::vector<double> pair_speed_, pair_growth_;

@@ -296,6 +296,21 @@ NB_MODULE(_core, m) {
         c.lever_growth(joints_of(c, dq), out.data());
         return out;
       }, "dq"_a)
+      .def("first_order_speeds", [](const kcplan::Chain& c, const std::vector<double>& q,
+                                    const std::vector<double>& dq) {
+        std::vector<coal::Transform3s> joints, frames;
+        c.body_frames(joints_of(c, q), joints, frames);
+        std::vector<double> centres, out(c.bodies().size());
+        for (const coal::Transform3s& f : frames)
+          for (int i = 0; i < 3; ++i) centres.push_back(f.getTranslation()[i]);
+        c.first_order_speeds(joints, centres.data(), joints_of(c, dq), out.data());
+        return out;
+      }, "q"_a, "dq"_a)
+      .def("point_accelerations", [](const kcplan::Chain& c, const std::vector<double>& dq) {
+        std::vector<double> out(c.bodies().size());
+        c.point_accelerations(joints_of(c, dq), out.data());
+        return out;
+      }, "dq"_a)
       .def("body_frames", [](const kcplan::Chain& c, const std::vector<double>& q) {
         std::vector<coal::Transform3s> joints, frames;
         c.body_frames(joints_of(c, q), joints, frames);
@@ -333,14 +348,14 @@ NB_MODULE(_core, m) {
       .def(
           "__init__",
           [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
-             std::size_t cache_entries, bool probes, bool part_balls) {
+             std::size_t cache_entries, bool probes, bool part_balls, bool first_order) {
             kcplan::ArmCertifierOptions o;
             o.max_guards = max_guards, o.cache_entries = cache_entries, o.probes = probes;
-            o.part_balls = part_balls;
+            o.part_balls = part_balls, o.first_order = first_order;
             new (self) kcplan::ArmCertifier(world, o);
           },
           "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
-          "part_balls"_a = true, nb::keep_alive<1, 2>())
+          "part_balls"_a = true, "first_order"_a = true, nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();
@@ -368,5 +383,6 @@ NB_MODULE(_core, m) {
       .def_prop_ro("cache_size", [](const kcplan::ArmCertifier& c) { return c.cache().size(); })
       .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards)
       .def_prop_ro("probes", &kcplan::ArmCertifier::probes)
-      .def_prop_ro("part_balls", &kcplan::ArmCertifier::part_balls);
+      .def_prop_ro("part_balls", &kcplan::ArmCertifier::part_balls)
+      .def_prop_ro("first_order", &kcplan::ArmCertifier::first_order);
 }

@@ -172,6 +172,52 @@ void Chain::lever_growth(const double* dq, double* out) const {
   }
 }
 
+void Chain::first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
+                               const double* dq, double* out) const {
+  // per joint frame: its angular velocity w and u, the velocity of a point x being w x x + u
+  std::vector<coal::Vec3s> w(joints_.size() + 1, coal::Vec3s::Zero()), u = w;
+  for (std::size_t i = 1; i <= joints_.size(); ++i) {
+    const ChainJoint& joint = joints_[i - 1];
+    w[i] = w[joint.parent], u[i] = u[joint.parent];
+    const coal::Vec3s axis = joints[i].getRotation() * joint.axis;
+    const double step = dq[joint.state];
+    if (joint.prismatic) {
+      u[i] += step * axis;
+    } else {
+      w[i] += step * axis;
+      u[i] -= step * axis.cross(joints[i].getTranslation());
+    }
+  }
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    const int i = bodies_[k].joint;
+    const coal::Vec3s c(centres[3 * k], centres[3 * k + 1], centres[3 * k + 2]);
+    const coal::Vec3s v = w[i].cross(c) + u[i];
+    out[k] = (v.norm() + w[i].norm() * bodies_[k].a_max) * (1.0 + 1e-12);  // and rounding
+  }
+}
+
+void Chain::point_accelerations(const double* dq, double* out) const {
+  const std::size_t dof = lower_.size();
+  std::vector<double> turning(joints_.size() + 1, 0.0);  // S: revolute steps above each joint
+  for (std::size_t i = 1; i <= joints_.size(); ++i) {
+    const int parent = joints_[i - 1].parent;
+    turning[i] = turning[parent];
+    if (parent > 0 && !joints_[parent - 1].prismatic)
+      turning[i] += std::abs(dq[joints_[parent - 1].state]);
+  }
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    double below = 0.0, M = 0.0;
+    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {
+      const ChainJoint& joint = joints_[i - 1];
+      const double step = std::abs(dq[joint.state]);
+      below += step * rho_[k * dof + joint.state];
+      M += joint.prismatic ? step * turning[i]
+                           : step * (2.0 * turning[i] * rho_[k * dof + joint.state] + below);
+    }
+    out[k] = M * (1.0 + 1e-12);
+  }
+}
+
 std::vector<double> Chain::relative_speeds(const std::vector<std::array<int, 2>>& pairs) const {
   const std::size_t dof = lower_.size();
   std::vector<double> out(pairs.size() * dof, 0.0);

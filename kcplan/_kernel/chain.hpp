@@ -88,6 +88,17 @@ class Chain {
   /// carry k (they alone change |x - o_j|), 0 for a prismatic j or one not carrying k
   /// (kcplan/arm/bounds.py lever_growth).
   void lever_growth(const double* dq, double* out) const;
+  /// First order at a configuration (kcplan/arm/bounds.py first_order_speeds): out[k] =
+  /// |u_k| + |w_k| a_max,k, the fastest any point of body k moves along the signed joint
+  /// step `dq`, from the body's twist (w_k, u_k) at one q: its joint_frames and the
+  /// bodies' centres there (3 numbers per body).
+  void first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
+                          const double* dq, double* out) const;
+  /// The largest acceleration of any point of body k along an edge of joint steps |dq| =
+  /// `dq` in the limits (kcplan/arm/bounds.py point_accelerations): out[k] = sum over the
+  /// revolute joints j carrying k of |dq_j| (2 S_j rho[k, j] + sum_{i = j or below} |dq_i|
+  /// rho[k, i]), plus |dq_j| S_j per prismatic j, S_j the revolute steps above j.
+  void point_accelerations(const double* dq, double* out) const;
   /// The bound on how fast the distance between a point of body k and a point of body l
   /// changes per unit of joint j's motion: only the joints that carry exactly one of
   /// them count (kcplan/arm/bounds.py relative_speeds). Row m for pairs[m], dof per row.

@@ -47,8 +47,30 @@ through ``o_j``), each at most at ``|dq_i| rho[k, i]``. So within ``t`` of ``m``
 
 (:func:`lever_growth` gives the terms of ``Q_k``; a prismatic joint's lever is 1 and does
 not grow). A self pair's terms sum those of the joints that carry one body only, as for
-its speed. These are the bounds of the clearance-ball certificate for arms: a body whose
-clearance ``d`` at ``q(m)`` exceeds ``min(v t, A t + Q t^2 / 2)`` stays free within ``t``.
+its speed.
+
+*First order* at a guard. The sum ``A_k`` adds every joint's contribution by its size;
+the contributions are vectors and partly cancel. At ``q(m)`` body ``k`` moves rigidly with
+angular velocity ``w = sum_j dq_j w_j`` (revolute ``j``) and centre velocity
+``u = sum_j dq_j w_j x (c_k - o_j) + sum_j dq_j w_j`` (prismatic), signed ``dq``, so every
+point moves at ``|u + w x (x - c_k)| <= |u| + |w| a_max,k =: A1_k`` (:func:`first_order_speeds`;
+median half of ``A_k`` on random Panda edges). Along the edge the acceleration of a point
+is, differentiating ``dx/ds`` once more (the axis ``w_j`` turns with the joints above ``j``
+at most at ``S_j = sum_{i above j, revolute} |dq_i|``, and ``o_j`` moves with them),
+
+    |d2x/ds2| <= M_k = sum_{j revolute} |dq_j| (2 S_j rho[k, j] + sum_{i <= j} |dq_i| rho[k, i])
+                     + sum_{j prismatic} |dq_j| S_j          (i <= j: j and the joints below)
+
+(:func:`point_accelerations`; ``rho[k, i] = 1`` for a prismatic ``i``): the first ``S_j``
+term is the turning axis ``(Omega_j x w_j) x (x - o_j)``, the second the frame's own turn in
+``w_j x (dx/ds - do_j/ds)``, the sum the joints from ``j`` down. By Taylor's theorem with
+its integral remainder, within ``t`` of ``m``
+
+    |x(s) - x(m)| <= A1_k t + M_k t^2 / 2.
+
+These are the bounds of the clearance-ball certificate for arms: a body whose clearance
+``d`` at ``q(m)`` exceeds ``min(v t, A t + Q t^2 / 2, A1 t + M t^2 / 2)`` stays free within
+``t`` (pairs take the first two).
 """
 
 from __future__ import annotations
@@ -58,11 +80,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.kinematics import body_frames, joint_frames
+from kcplan.arm.kinematics import body_frames, joint_axes, joint_frames
 from kcplan.arm.model import ArmModel
 
 __all__ = [
     "carries",
+    "first_order_speeds",
+    "point_accelerations",
     "lever_growth",
     "levers",
     "chain_speeds",
@@ -191,5 +215,63 @@ def lever_growth(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:
             if arm.kinds[j] != "prismatic":
                 out[k, j] = step[j] * below
             below += step[j] * rho[k, j]
+            i = int(model.parents[i])
+    return out
+
+
+def first_order_speeds(arm: ArmModel, state: Sequence[float], dq: Sequence[float]) -> NDArray:
+    """``A1[k] = |u_k| + |w_k| a_max,k``: the fastest any point of body ``k`` moves at
+    ``state`` along the joint step ``dq`` (signed, per unit of the edge parameter), from
+    the body's exact twist there (module docstring, *First order*); shape
+    ``(len(arm.bodies),)``, metres."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    step = np.asarray(dq, dtype=float)
+    joints, bodies, local = joint_frames(arm, state), body_frames(arm, state), joint_axes(arm)
+    w = np.zeros((model.njoints, 3))  # angular velocity of each joint's frame
+    u = np.zeros((model.njoints, 3))  # with w: the velocity of a point x is w x x + u
+    for i in range(1, model.njoints):
+        parent = int(model.parents[i])
+        w[i], u[i] = w[parent], u[parent]
+        j = state_of.get(i)
+        if j is None:
+            continue
+        axis = joints[i][:3, :3] @ local[i]
+        if arm.kinds[j] == "prismatic":
+            u[i] = u[i] + step[j] * axis
+        else:
+            w[i] = w[i] + step[j] * axis
+            u[i] = u[i] - step[j] * np.cross(axis, joints[i][:3, 3])
+    out = np.zeros(len(arm.bodies))
+    for k, body in enumerate(arm.bodies):
+        i, c = body.joint, bodies[k][:3, 3]
+        spin = np.linalg.norm(w[i]) * body.semi_axes.max()
+        out[k] = np.linalg.norm(np.cross(w[i], c) + u[i]) + spin
+    return out
+
+
+def point_accelerations(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:
+    """``M[k]``: the largest acceleration (per unit of the edge parameter, squared) of any
+    point of body ``k`` anywhere along an edge of joint step ``dq`` in the limits (module
+    docstring, *First order*); shape ``(len(arm.bodies),)``, metres."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    rho, step = point_speeds(arm), np.abs(np.asarray(dq, dtype=float))
+    turning = np.zeros(model.njoints)  # S: how fast each joint's frame turns at most
+    for i in range(1, model.njoints):
+        parent, j = int(model.parents[i]), state_of.get(int(model.parents[i]))
+        turning[i] = turning[parent] + (
+            step[j] if j is not None and arm.kinds[j] != "prismatic" else 0.0
+        )
+    out = np.zeros(len(arm.bodies))
+    for k, body in enumerate(arm.bodies):
+        below, i = 0.0, body.joint
+        while i > 0:
+            j = state_of[i]
+            below += step[j] * rho[k, j]
+            if arm.kinds[j] == "prismatic":
+                out[k] += step[j] * turning[i]
+            else:
+                out[k] += step[j] * (2.0 * turning[i] * rho[k, j] + below)
             i = int(model.parents[i])
     return out

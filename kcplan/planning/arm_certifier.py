@@ -9,9 +9,15 @@ of ``s``, and no two points of ``k`` and ``l`` approach faster than ``v_kl``
 farther than ``A t + Q t^2 / 2``, with ``A`` from the levers at ``q(m)`` (the farthest
 points from each joint's origin there) and ``Q`` from how fast they can grow along the
 edge (:func:`kcplan.arm.bounds.levers`, :func:`kcplan.arm.bounds.lever_growth`; a pair
-takes the joints that carry one of its bodies only). So for ``|s - m| < r`` with
+takes the joints that carry one of its bodies only); nor, for a body, farther than
+``A1 t + M t^2 / 2``, with ``A1`` from its exact twist at ``q(m)`` and ``M`` its largest
+acceleration along the edge (:func:`kcplan.arm.bounds.first_order_speeds`,
+:func:`kcplan.arm.bounds.point_accelerations`: Taylor's theorem with its remainder; the
+twist's joint contributions partly cancel, so ``A1`` is about half of ``A``). So for
+``|s - m| < r`` with
 
-    r = min over bodies and pairs of max( d / v , t ),  A t + Q t^2 / 2 = d
+    r = min over bodies and pairs of max( d / v , t , t1 ),
+        A t + Q t^2 / 2 = d,  A1 t1 + M t1^2 / 2 = d  (t1 = 0 for a pair)
 
 every body stays clear of every obstacle (it was ``d_k`` away and moved less than
 ``d_k``) and of every body it may collide with: the stretch ``(m - r, m + r)`` is free.
@@ -38,7 +44,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kcplan.arm.bounds import carries, lever_growth, levers, point_speeds, relative_speeds
+from kcplan.arm.bounds import (
+    carries,
+    first_order_speeds,
+    lever_growth,
+    levers,
+    point_accelerations,
+    point_speeds,
+    relative_speeds,
+)
 from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
 from kcplan.planning.guard import GuardCache
 
@@ -64,12 +78,13 @@ MAX_PROBES = 64
 @dataclass(frozen=True, eq=False)
 class ArmGuard:
     """One guard of an arm: the certain clearance of each body to the scene
-    ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres, and the levers at
-    its state (:func:`kcplan.arm.bounds.levers`, ``(bodies, dof)``)."""
+    ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres, the levers at
+    its state (:func:`kcplan.arm.bounds.levers`, ``(bodies, dof)``) and the state."""
 
     scene: np.ndarray
     pairs: np.ndarray
     levers: np.ndarray
+    state: np.ndarray
 
     @property
     def clearance(self) -> float:
@@ -100,16 +115,24 @@ class ArmEdgeCertifier:
     cache_entries : int
         States whose validity and guard are remembered (the rigid certifier's
         :class:`kcplan.planning.guard.GuardCache`: the oldest are dropped first).
+    first_order : bool
+        Bound the bodies' motion by their twist at the guard as well (module docstring);
+        False: the levers alone (the ablation).
     """
 
     backend = "python"
     certificates = ("ball",)
 
     def __init__(
-        self, world, max_guards: int = 256, cache_entries: int = 200_000, probes: bool = True
+        self,
+        world,
+        max_guards: int = 256,
+        cache_entries: int = 200_000,
+        probes: bool = True,
+        first_order: bool = True,
     ):
         self.world, self.arm = world, world.arm
-        self.probes = bool(probes)
+        self.probes, self.first_order = bool(probes), bool(first_order)
         self.n = self.arm.dof
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
@@ -147,7 +170,7 @@ class ArmEdgeCertifier:
 
     def _measure(self, q: np.ndarray) -> ArmGuard:
         self.counters["guards"] += 1
-        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q))
+        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q), q)
 
     def _endpoint(self, q: np.ndarray) -> ArmGuard:
         key = q.tobytes()
@@ -162,25 +185,31 @@ class ArmEdgeCertifier:
 
     def _terms(self, q1: np.ndarray, q2: np.ndarray) -> tuple:
         """What a guard's radius needs of the edge: the global speeds of the bodies and
-        pairs, ``|dq|``, and the growth terms ``Q`` of bodies and pairs (module docs)."""
+        pairs, ``|dq|``, the growth terms ``Q`` of bodies and pairs, the bodies' largest
+        accelerations ``M`` and the signed step (module docs)."""
         dq = np.abs(q2 - q1)
         growth = lever_growth(self.arm, dq)
         first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
         only_first, only_second = self._only
         pair_growth = (growth[first] * only_first + growth[second] * only_second).sum(axis=1)
-        return self._rho @ dq, self._rho_pairs @ dq, dq, growth.sum(axis=1), pair_growth
+        accel = point_accelerations(self.arm, dq)
+        return (self._rho @ dq, self._rho_pairs @ dq, dq, growth.sum(axis=1), pair_growth,
+                accel, q2 - q1)  # fmt: skip
 
     def _radius(self, guard: ArmGuard, terms: tuple) -> float:
         """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
         if guard.clearance <= 0.0:
             return 0.0
-        speed, pair_speed, dq, growth, pair_growth = terms
+        speed, pair_speed, dq, growth, pair_growth, accel, step = terms
         first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
         only_first, only_second = self._only
         L = guard.levers
         pair_levers = L[first] * only_first + L[second] * only_second
+        twist = None
+        if self.first_order:
+            twist = (first_order_speeds(self.arm, guard.state, step), accel)
         r = min(
-            _reach(guard.scene, speed, L @ dq, growth),
+            _reach(guard.scene, speed, L @ dq, growth, twist),
             _reach(guard.pairs, pair_speed, pair_levers @ dq, pair_growth),
         )
         return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
@@ -261,13 +290,24 @@ def _length(dq: np.ndarray) -> float:
     return math.sqrt(sum(float(d) * float(d) for d in dq))
 
 
-def _reach(d: np.ndarray, v: np.ndarray, A: np.ndarray, Q: np.ndarray) -> float:
+def _reach(
+    d: np.ndarray, v: np.ndarray, A: np.ndarray, Q: np.ndarray, twist: tuple | None = None
+) -> float:
     """The smallest radius clearances ``d`` give to parts of global speed ``v``, lever term
-    ``A`` and growth ``Q``: ``max(d / v, t)`` with ``A t + Q t^2 / 2 = d`` (module docs;
-    ``inf`` for parts that do not move, and for none)."""
+    ``A`` and growth ``Q``: ``max(d / v, t)`` with ``A t + Q t^2 / 2 = d``, and with
+    ``twist = (A1, M)`` the root of ``A1 t + M t^2 / 2 = d`` as well (module docs; ``inf``
+    for parts that do not move, and for none)."""
     moving = v > 0
     if not moving.any():
         return math.inf
-    d, v, A, Q = d[moving], v[moving], A[moving], Q[moving]
-    root = 2.0 * d / (A + np.sqrt(A * A + 2.0 * Q * d))  # the stable form of the root
-    return float(np.maximum(d / v, root).min())
+    t = np.maximum(d[moving] / v[moving], _root(d[moving], A[moving], Q[moving]))
+    if twist is not None:
+        A1, M = twist
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.fmax(t, _root(d[moving], A1[moving], M[moving]))
+    return float(t.min())
+
+
+def _root(d: np.ndarray, A: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """The root ``t`` of ``A t + Q t^2 / 2 = d``, in its stable form."""
+    return 2.0 * d / (A + np.sqrt(A * A + 2.0 * Q * d))

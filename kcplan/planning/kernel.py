@@ -153,6 +153,9 @@ class KernelArmCertifier:
         links' bodies show that none of them can limit a guard's radius, and ask a pair's
         bounding-ball gap only when its group is near (``ArmCertifier``; the radii, and so
         the decisions, are those without it). False: every pair at every guard.
+    first_order : bool
+        Bound the bodies' motion by their twist at each guard as well
+        (:mod:`kcplan.planning.arm_certifier`); False is the ablation.
 
     Notes
     -----
@@ -173,12 +176,14 @@ class KernelArmCertifier:
         cache_entries: int = 200_000,
         probes: bool = True,
         part_balls: bool = True,
+        first_order: bool = True,
     ):
         self.world = world
         self.n = world.arm.dof
         self.compiled = _CompiledArmCertifier(
-            world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls)
-        )
+            world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls),
+            bool(first_order),
+        )  # fmt: skip
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have

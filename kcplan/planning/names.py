@@ -57,6 +57,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",
     "kc-rrtconnect-noparts",
+    "kc-rrtconnect-nofirst",
     "kc-prm-noprobe",
     "kc-rrtconnect-py",
     "kc-prm-py",

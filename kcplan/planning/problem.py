@@ -73,6 +73,7 @@ class PlannerSpec:
     probes: int = DEFAULT_PROBES  # collision probes per edge before its guards (kc)
     joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
     part_balls: bool = True  # arms (kc, kernel): far groups of self pairs decided at once
+    first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
 
     @property
     def kc(self) -> bool:
@@ -126,6 +127,13 @@ PLANNERS: dict[str, PlannerSpec] = {
         "pair, without the links' balls that decide far groups of pairs at once (the "
         "world's state checks, every planner's, use those balls either way)",
         part_balls=False,
+    ),
+    "kc-rrtconnect-nofirst": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation (arms): kc-rrtconnect bounding the bodies' motion near a guard "
+        "by the chain's levers alone, without their twist there (first order)",
+        first_order=False,
     ),
     "kc-prm-noprobe": PlannerSpec(
         og.PRM,
@@ -540,8 +548,9 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     n = arm.dof
     if spec.kc:
         validator = KCMotionValidator(
-            si, arm, world, backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls
-        )
+            si, arm, world, backend=spec.backend, probes=spec.probes,
+            part_balls=spec.part_balls, first_order=spec.first_order,
+        )  # fmt: skip
         si.setMotionValidator(validator)
         state_valid = validator.state_valid
     elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand

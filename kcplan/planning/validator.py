@@ -100,6 +100,9 @@ class KCMotionValidator(ob.MotionValidator):
         Arms, compiled: decide the self pairs of two links far apart at once by balls
         around the links' bodies (``ArmCertifier``'s ``part_balls``; the same decisions,
         fewer pairs looked at). False is the ablation.
+    first_order : bool
+        Arms: bound each body's motion near a guard by its twist there as well
+        (:mod:`kcplan.planning.arm_certifier`); False is the ablation.
     """
 
     def __init__(
@@ -116,14 +119,16 @@ class KCMotionValidator(ob.MotionValidator):
         backend: str | None = None,
         probes: int = DEFAULT_PROBES,
         part_balls: bool = True,
+        first_order: bool = True,
     ):
         super().__init__(si)
         self.space = si.getStateSpace()  # not si itself: see the module docstring
         self.error: Exception | None = None
         if isinstance(world, ArmWorld):
             self._init_arm(
-                robot, world, certificates, fallback, max_guards, backend, probes, part_balls
-            )
+                robot, world, certificates, fallback, max_guards, backend, probes,
+                (part_balls, first_order),
+            )  # fmt: skip
             return
         max_guards = 64 if max_guards is None else max_guards
         robot = Robot.of(robot)
@@ -163,8 +168,9 @@ class KCMotionValidator(ob.MotionValidator):
                 self.checkMotion = self._check_kernel_se2 if self.n == 2 else self._check_kernel_se3
 
     def _init_arm(
-        self, arm, world, certificates, fallback, max_guards, backend, probes, part_balls
+        self, arm, world, certificates, fallback, max_guards, backend, probes, options
     ) -> None:
+        part_balls, first_order = options
         if arm is not world.arm:
             raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
         backend = "kernel" if backend is None else backend
@@ -178,13 +184,16 @@ class KCMotionValidator(ob.MotionValidator):
         max_guards = 256 if max_guards is None else max_guards
         if backend == "kernel":
             self.certifier = KernelArmCertifier(
-                world, max_guards, probes=probes > 0, part_balls=part_balls
-            )
+                world, max_guards, probes=probes > 0, part_balls=part_balls,
+                first_order=first_order,
+            )  # fmt: skip
             # the hot path: one call into the kernel with the joint vector(s)
             self.state_valid = self._valid_kernel_arm
             self.checkMotion = self._check_kernel_arm
         else:
-            self.certifier = ArmEdgeCertifier(world, max_guards, probes=probes > 0)
+            self.certifier = ArmEdgeCertifier(
+                world, max_guards, probes=probes > 0, first_order=first_order
+            )
         self.backend = backend
         self.n = arm.dof
         self._read = lambda state, n=arm.dof: joint_state(state, n)
