@@ -18,11 +18,14 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       probes_(options.probes),
       part_balls_(options.part_balls),
       first_order_(options.first_order),
+      kc_(options.kc_inflation),
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
       rho_pairs_(world.chain().relative_speeds(world.pairs())),
       rho_groups_(world.parts().relative_speeds(world.groups())) {
   if (max_guards_ < 1) throw std::invalid_argument("max_guards: expected at least 1");
+  if (!(kc_ >= 0.0) || !std::isfinite(kc_))
+    throw std::invalid_argument("kc_inflation: expected a finite number >= 0");
   speed_.resize(chain_.bodies().size());
   pair_speed_.resize(world.pairs().size());
   q_.resize(n_);
@@ -50,6 +53,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   step_.resize(n_);
   accel_.resize(speed_.size());
   first_.resize(speed_.size());
+  turn_.resize(speed_.size());
 }
 
 double ArmCertifier::root(double d, double A, double Q) {
@@ -66,6 +70,62 @@ double ArmCertifier::body_reach(const ArmGuard& guard, std::size_t k, double d) 
   terms(guard, k, A, Q);
   const double t = reach(d, speed_[k], A, Q);
   return first_order_ ? std::max(t, root(d, first_[k], accel_[k])) : t;
+}
+
+void ArmCertifier::twist(const ArmGuard& guard) {
+  chain_.twists(guard.joints, guard.centres.data(), step_.data(), w_, u_);
+  for (std::size_t k = 0; k < first_.size(); ++k)  // Chain::first_order_speeds
+    first_[k] = (u_[k].norm() + w_[k].norm() * chain_.bodies()[k].a_max) * (1.0 + 1e-12);
+}
+
+template <class Frames>
+double ArmCertifier::kc_reach(const ArmGuard& guard, std::size_t k, Frames& frames) {
+  const ChainBody& body = chain_.bodies()[k];
+  const std::array<double, 3>& a = body.semi_axes;
+  if (guard.grown[k] == 0) {
+    if (guard.scene[k] > kc_ * body.a_max) {
+      guard.grown[k] = 1;  // the grown body lies within kc a_max of the body: clear
+    } else {
+      ++grown_queries;
+      ++counters.collision_queries;
+      guard.grown[k] = world_.grown_clear(k, frames(), 1.0 + kc_) ? 1 : 2;
+    }
+  }
+  if (guard.grown[k] != 1) return 0.0;
+  const double a_min = std::min({a[0], a[1], a[2]});
+  const double turn = (body.a_max - a_min) * turn_[k];  // the support function's turn
+  // the centre moves at most v t and A t + Q t^2 / 2 (any point does); scaled by a_min
+  double A, Q;
+  terms(guard, k, A, Q);
+  const double budget = kc_ * a_min;
+  double t = speed_[k] + turn > 0.0 ? budget / (speed_[k] + turn)
+                                    : std::numeric_limits<double>::infinity();
+  t = std::max(t, root(budget, A + turn, Q));
+  if (first_order_) {  // |diag(a)^-1 R^T u|: the centre's velocity in the guard's axes
+    const coal::Vec3s b = frames()[k].getRotation().transpose() * u_[k];
+    const double nu = std::sqrt((b[0] / a[0]) * (b[0] / a[0]) + (b[1] / a[1]) * (b[1] / a[1]) +
+                                (b[2] / a[2]) * (b[2] / a[2])) * (1.0 + 1e-12);
+    t = std::max(t, root(kc_, nu + turn / a_min, accel_[k] / a_min));
+  }
+  return t;
+}
+
+template <class Frames>
+void ArmCertifier::body_radius(const ArmGuard& guard, std::size_t k, double enough, double& r,
+                               Frames& frames) {
+  double t = body_reach(guard, k, guard.scene[k]);
+  if (kc_ > 0.0 && t < std::min(r, enough)) {
+    const double kc = kc_reach(guard, k, frames);
+    if (kc > t) ++kc_reaches, t = kc;
+  }
+  if (!guard.scene_exact[k] && t < std::min(r, enough)) {
+    const double cap = std::numeric_limits<double>::infinity();
+    guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
+    guard.scene_exact[k] = 1;
+    ++refined_bodies;
+    t = std::max(t, body_reach(guard, k, guard.scene[k]));
+  }
+  r = std::min(r, t);
 }
 
 void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const {
@@ -206,12 +266,13 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   g.pair_known.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
-  if (first_order_) {
+  g.grown.assign(bodies, 0);
+  if (first_order_ || kc_ > 0.0) {
     g.joints = world_.joint_frames();
     g.centres.reserve(3 * bodies);
     for (const coal::Transform3s& f : frames)
       for (int i = 0; i < 3; ++i) g.centres.push_back(f.getTranslation()[i]);
-    chain_.first_order_speeds(g.joints, g.centres.data(), step_.data(), first_.data());
+    twist(g);
   }
   const Chain& parts = world_.parts();
   g.part_levers.resize(parts.bodies().size() * n_);
@@ -249,29 +310,18 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   if (guard.clearance <= 0.0) return 0.0;
   const std::size_t bodies = speed_.size();
   double r = std::numeric_limits<double>::infinity();
-  if (first_order_)  // the bodies' first order at this guard, for this edge
-    chain_.first_order_speeds(guard.joints, guard.centres.data(), step_.data(), first_.data());
-  for (std::size_t k = 0; k < bodies; ++k)
-    if (speed_[k] > 0.0 && guard.scene_exact[k]) r = std::min(r, body_reach(guard, k, guard.scene[k]));
+  if (first_order_ || kc_ > 0.0) twist(guard);  // the bodies' twists here, for this edge
   bool placed = false;
   const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
     if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
     return frames_;
   };
-  // a bound that would hold r below what is needed is refined first: the radius is then
-  // that of exact distances, or at least `enough`
-  for (std::size_t k = 0; k < bodies; ++k) {
-    if (!(speed_[k] > 0.0) || guard.scene_exact[k]) continue;
-    double t = body_reach(guard, k, guard.scene[k]);
-    if (t < std::min(r, enough)) {
-      const double cap = std::numeric_limits<double>::infinity();
-      guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
-      guard.scene_exact[k] = 1;
-      ++refined_bodies;
-      t = body_reach(guard, k, guard.scene[k]);
-    }
-    r = std::min(r, t);
-  }
+  // the measured clearances first; then a capped one that would hold r below what is
+  // needed is refined (after the KC guard): the radius is then that of exact distances
+  // (and KC guards), or at least `enough`
+  for (int exact = 1; exact >= 0; --exact)
+    for (std::size_t k = 0; k < bodies; ++k)
+      if (speed_[k] > 0.0 && guard.scene_exact[k] == exact) body_radius(guard, k, enough, r, frames);
   if (!part_balls_) {
     for (std::size_t m = 0; m < pair_speed_.size(); ++m) pair_radius(guard, m, enough, r, frames);
     return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
@@ -315,7 +365,8 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     speed_[k] = v;
   }
   chain_.lever_growth(dq_.data(), growth_.data());
-  if (first_order_) chain_.point_accelerations(dq_.data(), accel_.data());
+  if (first_order_ || kc_ > 0.0) chain_.point_accelerations(dq_.data(), accel_.data());
+  if (kc_ > 0.0) chain_.turn_speeds(dq_.data(), turn_.data());
   ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_terms)
   if (part_balls_) {
     const Chain& parts = world_.parts();

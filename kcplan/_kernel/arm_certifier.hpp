@@ -34,6 +34,9 @@ struct ArmGuard {
   std::vector<double> part_centres;  ///< the parts' centres at q: 3 per part
   mutable std::vector<double> scene, pairs;
   mutable std::vector<char> scene_exact, pair_known;
+  /// Body k's KC guard (its body grown by 1 + the certifier's kc_inflation about its
+  /// centre): 0 not asked yet, 1 certainly clear of the scene, 2 not known to be.
+  mutable std::vector<char> grown;
   /// > 0: no body at q is known to touch anything (the scene's smallest bound, and of the
   /// pairs known); set to 0 when a pair is found in contact. A guard whose pairs are not
   /// all known is cached only at an end of an edge, whose radius() is asked at once: a
@@ -56,6 +59,10 @@ struct ArmCertifierOptions {
   /// first_order_speeds, Chain::point_accelerations); false: the levers alone (the
   /// ablation).
   bool first_order = true;
+  /// The KC certificate's inflation eps > 0: a body also stays free while it stays inside
+  /// its body grown by 1 + eps at a guard, proved clear by one query (the class docs); 0:
+  /// the clearance ball alone (the `ca` ablation).
+  double kc_inflation = 0.0;
   std::size_t cache_entries = 200000;
 };
 
@@ -74,6 +81,18 @@ struct ArmCertifierOptions {
 /// each body stays clear of the scene and of each body it may collide with, and the
 /// covers hold the links.
 /// kcplan/planning/arm_certifier.py has the proof in full.
+///
+/// The KC certificate (kc_inflation = eps > 0) is a second proof for each body's scene
+/// clearance, tried where the ball leaves a body short: the body grown about its centre
+/// by 1 + eps at the guard (its guard, in the paper's words) is proved clear by one query
+/// (World::grown_body_clear), and the body stays inside it while, in the guard's frame,
+/// its centre's displacement d and its turn theta keep |diag(a)^-1 d| + (a_max - a_min)
+/// theta / a_min <= eps (the ellipsoid's support function turns at most a_max - a_min per
+/// radian, kcplan/planning/certificates/ball.py). With d <= u t + M t^2 / 2 (the centre's
+/// velocity u at the guard, Taylor's remainder), d <= min(v t, A t + Q t^2 / 2) and theta
+/// <= w t (Chain::turn_speeds) this is a reach in t like the ball's; a body takes the
+/// larger of the two. A body moving along its long axes may so go much farther than its
+/// clearance. Self pairs keep the ball.
 ///
 /// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
 /// outside the limits or not finite rejects the edge with no query; (2) q2's validity
@@ -129,7 +148,10 @@ class ArmCertifier {
   bool probes() const { return probes_; }
   bool part_balls() const { return part_balls_; }
   bool first_order() const { return first_order_; }
+  double kc_inflation() const { return kc_; }
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
+  std::int64_t grown_queries = 0;  ///< KC guards asked (one body query each)
+  std::int64_t kc_reaches = 0;     ///< bodies whose KC reach beat their ball's where asked
   CertifierCounters counters;
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
   std::int64_t skipped_groups = 0;  ///< groups of pairs a radius decided by their parts
@@ -145,6 +167,7 @@ class ArmCertifier {
   const Chain& chain_;
   int n_, max_guards_;
   bool probes_, part_balls_, first_order_;
+  double kc_;
   ArmGuardCache cache_;
   /// The radius a clearance d gives to a body or pair of global speed v, lever term A
   /// and growth Q (the class docs).
@@ -153,6 +176,17 @@ class ArmCertifier {
   static double root(double d, double A, double Q);
   /// Body k's radius from the clearance d at `guard`: reach, and the first order's root.
   double body_reach(const ArmGuard& guard, std::size_t k, double d) const;
+  /// Body k's radius from its KC guard (the class docs), 0 if that is not clear; asks the
+  /// guard's query on first use. Needs twist() of `guard` and the bodies' frames there.
+  template <class Frames>
+  double kc_reach(const ArmGuard& guard, std::size_t k, Frames& frames);
+  /// Body k's part of radius(): the ball, then (kc) its KC guard, then (a capped
+  /// clearance) the clearance measured again, each only while r stays below min(r, enough).
+  template <class Frames>
+  void body_radius(const ArmGuard& guard, std::size_t k, double enough, double& r,
+                   Frames& frames);
+  /// The bodies' twists at `guard` for the current edge (w_, u_) and first_.
+  void twist(const ArmGuard& guard);
   /// A and Q of body k (k < bodies) or of pair k - bodies, for the current edge.
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
   /// The radius group g's gap gives all its pairs, for the current edge.
@@ -171,6 +205,8 @@ class ArmCertifier {
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
   std::vector<double> speed_, q_, caps_, dq_, growth_, step_, accel_;
   mutable std::vector<double> first_;  // A1 of the bodies at the guard of the radius asked
+  std::vector<coal::Vec3s> w_, u_;     // their twists there (twist())
+  std::vector<double> turn_;           // per body: Chain::turn_speeds of the edge
   /// Self pair m's speed and growth for the current edge, computed when first needed.
   void pair_terms(std::size_t m) const;
   mutable std::vector<double> pair_speed_, pair_growth_;

@@ -92,6 +92,12 @@ class ArmWorld {
   double body_clearance(std::size_t k, const std::vector<coal::Transform3s>& frames, double cap) {
     return scene_->body_safe_clearance(k, frames[k], cap);
   }
+  /// Whether body k at `frames[k]`, grown about its centre by `scale` (semi-axes times
+  /// scale >= 1), is certainly clear of the obstacles (World::grown_body_clear; the KC
+  /// guard of a body; self pairs are not looked at).
+  bool grown_clear(std::size_t k, const std::vector<coal::Transform3s>& frames, double scale) {
+    return scene_->grown_body_clear(k, frames[k], scale);
+  }
   /// A certain lower bound of self pair m's distance with the bodies at `frames`: the
   /// gap between their bounding balls, less rounding (<= 0: nothing known).
   double pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;

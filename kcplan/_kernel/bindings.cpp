@@ -306,6 +306,11 @@ NB_MODULE(_core, m) {
         c.first_order_speeds(joints, centres.data(), joints_of(c, dq), out.data());
         return out;
       }, "q"_a, "dq"_a)
+      .def("turn_speeds", [](const kcplan::Chain& c, const std::vector<double>& dq) {
+        std::vector<double> out(c.bodies().size());
+        c.turn_speeds(joints_of(c, dq), out.data());
+        return out;
+      }, "dq"_a)
       .def("point_accelerations", [](const kcplan::Chain& c, const std::vector<double>& dq) {
         std::vector<double> out(c.bodies().size());
         c.point_accelerations(joints_of(c, dq), out.data());
@@ -332,6 +337,12 @@ NB_MODULE(_core, m) {
         w.safe_clearances(joints_of(w.chain(), q), scene.data(), pairs.data());
         return nb::make_tuple(scene, pairs);
       }, "q"_a)
+      .def("grown_clear", [](kcplan::ArmWorld& w, const std::vector<double>& q, double scale) {
+        const std::vector<coal::Transform3s>& frames = w.place(joints_of(w.chain(), q));
+        std::vector<bool> out(frames.size());
+        for (std::size_t k = 0; k < frames.size(); ++k) out[k] = w.grown_clear(k, frames, scale);
+        return out;
+      }, "q"_a, "scale"_a)
       .def_prop_ro("counters", [](kcplan::ArmWorld& w) {
         nb::dict d = world_counters(w.scene());
         d["pair_queries"] = w.pair_queries;
@@ -348,14 +359,17 @@ NB_MODULE(_core, m) {
       .def(
           "__init__",
           [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
-             std::size_t cache_entries, bool probes, bool part_balls, bool first_order) {
+             std::size_t cache_entries, bool probes, bool part_balls, bool first_order,
+             double kc_inflation) {
             kcplan::ArmCertifierOptions o;
             o.max_guards = max_guards, o.cache_entries = cache_entries, o.probes = probes;
             o.part_balls = part_balls, o.first_order = first_order;
+            o.kc_inflation = kc_inflation;
             new (self) kcplan::ArmCertifier(world, o);
           },
           "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
-          "part_balls"_a = true, "first_order"_a = true, nb::keep_alive<1, 2>())
+          "part_balls"_a = true, "first_order"_a = true, "kc_inflation"_a = 0.0,
+          nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();
@@ -373,6 +387,8 @@ NB_MODULE(_core, m) {
         d["refined_pairs"] = c.refined_pairs;
         d["refined_bodies"] = c.refined_bodies;
         d["skipped_groups"] = c.skipped_groups;
+        d["grown_queries"] = c.grown_queries;
+        d["kc_reaches"] = c.kc_reaches;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {
@@ -384,5 +400,6 @@ NB_MODULE(_core, m) {
       .def_prop_ro("max_guards", &kcplan::ArmCertifier::max_guards)
       .def_prop_ro("probes", &kcplan::ArmCertifier::probes)
       .def_prop_ro("part_balls", &kcplan::ArmCertifier::part_balls)
-      .def_prop_ro("first_order", &kcplan::ArmCertifier::first_order);
+      .def_prop_ro("first_order", &kcplan::ArmCertifier::first_order)
+      .def_prop_ro("kc_inflation", &kcplan::ArmCertifier::kc_inflation);
 }

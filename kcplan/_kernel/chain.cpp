@@ -172,8 +172,9 @@ void Chain::lever_growth(const double* dq, double* out) const {
   }
 }
 
-void Chain::first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
-                               const double* dq, double* out) const {
+void Chain::twists(const std::vector<coal::Transform3s>& joints, const double* centres,
+                   const double* dq, std::vector<coal::Vec3s>& w_out,
+                   std::vector<coal::Vec3s>& u_out) const {
   // per joint frame: its angular velocity w and u, the velocity of a point x being w x x + u
   std::vector<coal::Vec3s> w(joints_.size() + 1, coal::Vec3s::Zero()), u = w;
   for (std::size_t i = 1; i <= joints_.size(); ++i) {
@@ -188,11 +189,28 @@ void Chain::first_order_speeds(const std::vector<coal::Transform3s>& joints, con
       u[i] -= step * axis.cross(joints[i].getTranslation());
     }
   }
+  w_out.resize(bodies_.size()), u_out.resize(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     const int i = bodies_[k].joint;
     const coal::Vec3s c(centres[3 * k], centres[3 * k + 1], centres[3 * k + 2]);
-    const coal::Vec3s v = w[i].cross(c) + u[i];
-    out[k] = (v.norm() + w[i].norm() * bodies_[k].a_max) * (1.0 + 1e-12);  // and rounding
+    w_out[k] = w[i], u_out[k] = w[i].cross(c) + u[i];
+  }
+}
+
+void Chain::first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
+                               const double* dq, double* out) const {
+  std::vector<coal::Vec3s> w, u;
+  twists(joints, centres, dq, w, u);
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    out[k] = (u[k].norm() + w[k].norm() * bodies_[k].a_max) * (1.0 + 1e-12);  // and rounding
+}
+
+void Chain::turn_speeds(const double* dq, double* out) const {
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    double turn = 0.0;
+    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent)
+      if (!joints_[i - 1].prismatic) turn += std::abs(dq[joints_[i - 1].state]);
+    out[k] = turn;
   }
 }
 

@@ -94,6 +94,16 @@ class Chain {
   /// bodies' centres there (3 numbers per body).
   void first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
                           const double* dq, double* out) const;
+  /// The bodies' twists at one q along the signed joint step `dq` (kcplan/arm/bounds.py
+  /// twists): w[k] the angular velocity of body k, u[k] the velocity of its centre, per
+  /// unit of the edge parameter (world frame), from joint_frames and the bodies' centres
+  /// (3 numbers per body) there. first_order_speeds is |u| + |w| a_max of these.
+  void twists(const std::vector<coal::Transform3s>& joints, const double* centres,
+              const double* dq, std::vector<coal::Vec3s>& w, std::vector<coal::Vec3s>& u) const;
+  /// out[k] = the sum of |dq_j| over the revolute joints j that carry body k: how far body
+  /// k turns at most per unit of the edge parameter, anywhere along the edge (radians;
+  /// kcplan/arm/bounds.py turn_speeds).
+  void turn_speeds(const double* dq, double* out) const;
   /// The largest acceleration of any point of body k along an edge of joint steps |dq| =
   /// `dq` in the limits (kcplan/arm/bounds.py point_accelerations): out[k] = sum over the
   /// revolute joints j carrying k of |dq_j| (2 S_j rho[k, j] + sum_{i = j or below} |dq_i|

@@ -475,6 +475,34 @@ double World::body_safe_clearance(std::size_t k, const coal::Transform3s& frame,
   return capped_clearance(k, cap);
 }
 
+bool World::grown_body_clear(std::size_t k, const coal::Transform3s& frame, double scale) {
+  if (!(scale >= 1.0) || !std::isfinite(scale))
+    throw std::invalid_argument("grown body: expected a finite scale >= 1");
+  if (objects_.empty()) return true;
+  if (!finalized_) finalize();
+  if (grown_.empty()) grown_.resize(bodies_.size());
+  const std::array<double, 3>& a = robot_.bodies()[k].semi_axes;
+  if (!grown_[k])
+    grown_[k] = std::make_unique<coal::CollisionObject>(
+        std::make_shared<coal::Ellipsoid>(a[0], a[1], a[2]));
+  coal::CollisionObject& grown = *grown_[k];
+  auto* shape = static_cast<coal::Ellipsoid*>(grown.collisionGeometry().get());
+  const coal::Vec3s radii(scale * a[0], scale * a[1], scale * a[2]);
+  if (shape->radii != radii) {
+    shape->radii = radii;
+    shape->computeLocalAABB();
+  }
+  grown.setTransform(frame);
+  grown.computeAABB();
+  count_body(k);
+  // clear when its distance is certainly positive: past the smallest cap that says so
+  const double cap = std::numeric_limits<double>::min();
+  const double raw = (cap + atol_) / (1.0 - rtol_);
+  DistanceNear near(this, &grown, k, raw);  // body k's warm starts: a shape like it
+  manager_->distance(&grown, &near);
+  return near.best >= raw || safe(near.best) > 0.0;
+}
+
 double World::capped_clearance(std::size_t k, double cap) {
   if (objects_.empty()) return std::numeric_limits<double>::infinity();
   count_body(k);

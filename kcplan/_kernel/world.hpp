@@ -136,6 +136,11 @@ class World {
   /// coal distance certainly is (never an overestimate).
   double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
 
+  /// Whether body k grown about its centre by `scale` (its semi-axes times scale >= 1)
+  /// and placed at `frame` is certainly clear of every obstacle: its clearance, reduced by
+  /// the error allowance, is positive (one body query; the KC guard of arms). The body
+  /// itself stays where it is.
+  bool grown_body_clear(std::size_t k, const coal::Transform3s& frame, double scale);
   /// Whether body k as placed touches an obstacle (one body's part of bodies_collide;
   /// counted as a body query, not as a collision query).
   bool body_collides(std::size_t k);
@@ -219,6 +224,7 @@ class World {
   std::vector<Support> supports_;
   std::vector<std::unique_ptr<const MeshPlanes>> planes_;  // per obstacle; null: not a mesh
   std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
+  std::vector<std::unique_ptr<coal::CollisionObject>> grown_;  // per body, made on first use
   std::vector<std::unique_ptr<coal::CollisionObject>> horizon_boxes_;
   std::vector<double> horizon_sides_;
   std::unique_ptr<coal::DynamicAABBTreeCollisionManager> manager_;

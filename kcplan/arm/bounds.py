@@ -94,6 +94,8 @@ __all__ = [
     "point_speeds",
     "relative_speeds",
     "speeds",
+    "turn_speeds",
+    "twists",
 ]
 
 
@@ -219,11 +221,13 @@ def lever_growth(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:
     return out
 
 
-def first_order_speeds(arm: ArmModel, state: Sequence[float], dq: Sequence[float]) -> NDArray:
-    """``A1[k] = |u_k| + |w_k| a_max,k``: the fastest any point of body ``k`` moves at
-    ``state`` along the joint step ``dq`` (signed, per unit of the edge parameter), from
-    the body's exact twist there (module docstring, *First order*); shape
-    ``(len(arm.bodies),)``, metres."""
+def twists(
+    arm: ArmModel, state: Sequence[float], dq: Sequence[float]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The bodies' twists at ``state`` along the signed joint step ``dq``: ``w[k]`` the
+    angular velocity of body ``k`` and ``u[k]`` the velocity of its centre, per unit of the
+    edge parameter (module docstring, *First order*), each of shape
+    ``(len(arm.bodies), 3)``, world frame (rad and metres)."""
     model = arm.model
     state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
     step = np.asarray(dq, dtype=float)
@@ -242,12 +246,28 @@ def first_order_speeds(arm: ArmModel, state: Sequence[float], dq: Sequence[float
         else:
             w[i] = w[i] + step[j] * axis
             u[i] = u[i] - step[j] * np.cross(axis, joints[i][:3, 3])
-    out = np.zeros(len(arm.bodies))
-    for k, body in enumerate(arm.bodies):
-        i, c = body.joint, bodies[k][:3, 3]
-        spin = np.linalg.norm(w[i]) * body.semi_axes.max()
-        out[k] = np.linalg.norm(np.cross(w[i], c) + u[i]) + spin
-    return out
+    at = [body.joint for body in arm.bodies]
+    centres = np.array([frame[:3, 3] for frame in bodies]).reshape(-1, 3)
+    return w[at], np.cross(w[at], centres) + u[at]
+
+
+def first_order_speeds(arm: ArmModel, state: Sequence[float], dq: Sequence[float]) -> NDArray:
+    """``A1[k] = |u_k| + |w_k| a_max,k``: the fastest any point of body ``k`` moves at
+    ``state`` along the joint step ``dq`` (signed, per unit of the edge parameter), from
+    the body's exact twist there (:func:`twists`; module docstring, *First order*); shape
+    ``(len(arm.bodies),)``, metres."""
+    w, u = twists(arm, state, dq)
+    a_max = np.array([body.semi_axes.max() for body in arm.bodies])
+    return np.linalg.norm(u, axis=1) + np.linalg.norm(w, axis=1) * a_max
+
+
+def turn_speeds(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:
+    """``turn[k] = sum_j |dq_j|`` over the revolute joints ``j`` that carry body ``k``: the
+    body's angular velocity along an edge of joint step ``dq`` is ``sum_j dq_j w_j`` (unit
+    axes ``w_j``), so it turns at most this far per unit of the edge parameter, anywhere
+    along the edge; shape ``(len(arm.bodies),)``, radians."""
+    revolute = np.array([kind != "prismatic" for kind in arm.kinds])
+    return (carries(arm) & revolute) @ np.abs(np.asarray(dq, dtype=float))
 
 
 def point_accelerations(arm: ArmModel, dq: Sequence[float]) -> NDArray[np.float64]:

@@ -19,8 +19,10 @@ order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm
 at most that much, with ``bodies_per_link`` as the most bodies per link; ``bodies_per_link``
 alone fits exactly that many (the smallest union); neither gives
 :data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`. A
-cylinder's axis is its local z. ``inflation`` is kept for the KC certificate of arms
-(to come); the clearance-ball certificate does not use it. Every field is validated with
+cylinder's axis is its local z. ``inflation`` is the KC guards' ``eps`` of the ``kc-*``
+planners (each body grown by ``1 + eps`` about its centre,
+:mod:`kcplan.planning.arm_certifier`); 0, the default, takes
+:data:`kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`. Every field is validated with
 the rigid format's one-line errors (:class:`kcplan.world.scenario.ScenarioError`).
 """
 

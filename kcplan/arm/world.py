@@ -140,15 +140,18 @@ class ArmWorld:
         if self._kernel is not None:
             self._kernel.reset_counters()
 
-    def _place(self, state: ArrayLike) -> list[EllipsoidSupport]:
-        """Place the bodies at ``state``; their support functions there."""
+    def _joints(self, state: ArrayLike) -> NDArray[np.float64]:
         q = np.asarray(state, dtype=float)
         if q.shape != (self.arm.dof,) or not np.isfinite(q).all():
             raise ValueError(
                 f"state: expected {self.arm.dof} finite joint values, got {q.tolist()}"
             )
+        return q
+
+    def _place(self, state: ArrayLike) -> list[EllipsoidSupport]:
+        """Place the bodies at ``state``; their support functions there."""
         supports = []
-        frames = body_frames(self.arm, q)
+        frames = body_frames(self.arm, self._joints(state))
         for obj, frame, body in zip(self._bodies, frames, self.arm.bodies, strict=True):
             obj.setTransform(fcl.Transform(frame[:3, :3], frame[:3, 3]))
             supports.append(EllipsoidSupport(frame[:3, 3], frame[:3, :3], body.semi_axes))
@@ -158,13 +161,17 @@ class ArmWorld:
         """A lower bound of the distance between body ``k`` and ``b`` (0 on contact): the
         support functions' separation along FCL's nearest points (module docstring), or
         FCL's distance where ``b`` has no support function (a mesh)."""
+        return self._distance_between(self._bodies[k], self._shapes[k], support_a, b, support_b)
+
+    def _distance_between(self, a, shape_a, support_a, b: fcl.CollisionObject, support_b) -> float:
+        """:meth:`_distance` of the object ``a`` (of geometry ``shape_a``) and ``b``."""
         result = fcl.DistanceResult()
-        d = fcl.distance(self._bodies[k], b, self._request, result)
+        d = fcl.distance(a, b, self._request, result)
         if d <= 0.0:
             return 0.0
         if support_b is None:
             return float(d)
-        if result.o1 is self._shapes[k]:
+        if result.o1 is shape_a:
             p_a, p_b = result.nearest_points
         else:  # FCL swaps some pairs (and their points)
             p_b, p_a = result.nearest_points
@@ -217,6 +224,33 @@ class ArmWorld:
                 piece = self._supports[i]
                 scene[k] = min(scene[k], self._distance(k, supports[k], self._objects[i], piece))
         return scene, self._pair_clearances(supports)
+
+    def grown_clear(self, state: ArrayLike, scale: float) -> NDArray[np.bool_]:
+        """Whether each body at ``state``, grown about its centre by ``scale`` (semi-axes
+        times ``scale >= 1``), is certainly clear of the obstacles, ``(bodies,)``: its
+        distance (module docstring) less FCL's allowance is positive. These are the KC
+        guards of :mod:`kcplan.planning.arm_certifier`; self pairs are not looked at (one
+        collision query)."""
+        if not (math.isfinite(scale) and scale >= 1.0):
+            raise ValueError(f"scale: expected a finite number >= 1, got {scale!r}")
+        frames = body_frames(self.arm, self._joints(state))
+        self._fcl_counters["collision_queries"] += 1
+        clear = np.ones(len(frames), dtype=bool)
+        if not self._objects:
+            return clear
+        for k, (frame, body) in enumerate(zip(frames, self.arm.bodies, strict=True)):
+            axes = scale * body.semi_axes
+            grown = fcl.Ellipsoid(*axes.tolist())
+            obj = fcl.CollisionObject(grown, fcl.Transform(frame[:3, :3], frame[:3, 3]))
+            support = EllipsoidSupport(frame[:3, 3], frame[:3, :3], axes)
+            box = self._body_boxes([support])[0]
+            gaps = np.maximum(np.maximum(self._boxes[:, 0] - box[1], box[0] - self._boxes[:, 1]), 0)
+            for i in np.flatnonzero(np.linalg.norm(gaps, axis=1) <= self.clearance_atol):
+                d = self._distance_between(obj, grown, support, self._objects[i], self._supports[i])
+                if not self._safe(np.array([d]))[0] > 0.0:
+                    clear[k] = False
+                    break
+        return clear
 
     def _pair_clearances(self, supports: list[EllipsoidSupport]) -> NDArray[np.float64]:
         """The self pairs' separations along FCL's nearest points, ``(pairs,)``, with the

@@ -32,8 +32,37 @@ cached guards left open: collision queries at the van der Corput points of that 
 price (a guard costs a distance query of every body and pair); they cost the certified
 edges a few cheap queries each.
 
-This is the ``ca`` certificate of arms (the rigid robots' clearance ball with the chain's
-speeds); it imports neither OMPL nor FCL (the world does the queries).
+*The KC certificate* (``kc_inflation = eps > 0``) is a second proof of each body's
+clearance to the scene, after the paper's idea that an ellipsoid may move far along its
+long axes and stay inside a slightly larger one. At a guard at ``q(m)`` body ``k``
+(``E = c_g + R_g diag(a) B``, ``B`` the unit ball) grown about its centre by ``1 + eps``,
+its *KC guard* ``G = c_g + R_g (1 + eps) diag(a) B``, is proved clear of the scene by one
+query (:meth:`kcplan.arm.ArmWorld.grown_clear`). At ``s`` the body is ``c(s) + R(s)
+diag(a) B``; in the guard's frame its centre is displaced by ``d = R_g^T (c(s) - c_g)``
+and it is turned by ``R_g^T R(s)``, by an angle ``theta``. For a unit ``n`` its support
+function is ``n . d + |diag(a) R(s)^T R_g n|``, and the turn moves it by at most ``(a_max -
+a_min) theta`` (:mod:`kcplan.planning.certificates.ball`: an ellipsoid's support function
+turns at most ``a_max - a_min`` per radian), while ``n . d <= |diag(a) n| |diag(a)^-1 d|``
+and ``|diag(a) n| >= a_min``. So the body lies inside ``G``, whose support function is
+``(1 + eps) |diag(a) n|``, as long as
+
+    |diag(a)^-1 d| + (a_max - a_min) theta / a_min <= eps          (KC)
+
+(the containment condition of the paper's Sec. 4, with the rotation and translation
+bounded separately). Along the edge ``theta <= w_k t`` (``w_k``: the revolute steps that
+carry the body, :func:`kcplan.arm.bounds.turn_speeds`), and the centre, a point of the
+body, moves by at most ``min(v t, A t + Q t^2 / 2)`` (so ``|diag(a)^-1 d|`` by that over
+``a_min``) and by ``u t + r``, ``|r| <= M t^2 / 2`` (``u`` the centre's velocity at
+``q(m)``, :func:`kcplan.arm.bounds.twists`; Taylor's remainder as above), so
+``|diag(a)^-1 d| <= |diag(a)^-1 R_g^T u| t + M t^2 / (2 a_min)``. Each gives a ``t``
+within which (KC) holds; the body's radius is the largest of those and of its ball's.
+Moving along its long axes (``|diag(a)^-1 R_g^T u|`` small) a body may go much farther
+than its clearance. Self pairs keep the ball. A KC guard is asked only where the ball
+leaves a body short, and cached with its guard.
+
+With ``kc_inflation = 0`` this is the ``ca`` certificate of arms (the rigid robots'
+clearance ball with the chain's speeds). The module imports neither OMPL nor FCL (the
+world does the queries).
 """
 
 from __future__ import annotations
@@ -46,17 +75,26 @@ from numpy.typing import ArrayLike
 
 from kcplan.arm.bounds import (
     carries,
-    first_order_speeds,
     lever_growth,
     levers,
     point_accelerations,
     point_speeds,
     relative_speeds,
+    turn_speeds,
+    twists,
 )
+from kcplan.arm.kinematics import body_frames
 from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
 from kcplan.planning.guard import GuardCache
 
-__all__ = ["ARM_COUNTER_NAMES", "MAX_PROBES", "PROBE_STEP", "ArmEdgeCertifier", "ArmGuard"]
+__all__ = [
+    "ARM_COUNTER_NAMES",
+    "DEFAULT_KC_INFLATION",
+    "MAX_PROBES",
+    "PROBE_STEP",
+    "ArmEdgeCertifier",
+    "ArmGuard",
+]
 
 ARM_COUNTER_NAMES = tuple(
     name
@@ -73,18 +111,24 @@ PROBE_STEP = 0.1
 ``ArmCertifier::kProbeStep``. OMPL's default discrete check of the Panda steps 0.134."""
 MAX_PROBES = 64
 """Probes per edge at most (``ArmCertifier::kMaxProbes``)."""
+DEFAULT_KC_INFLATION = 0.2
+"""The KC guard's inflation ``eps`` of the ``kc-*`` planners on arms (a scenario's
+``robot.inflation`` overrides it): each body grown by 1.2 about its centre."""
 
 
 @dataclass(frozen=True, eq=False)
 class ArmGuard:
     """One guard of an arm: the certain clearance of each body to the scene
     ``(bodies,)`` and of each checked self pair ``(pairs,)``, metres, the levers at
-    its state (:func:`kcplan.arm.bounds.levers`, ``(bodies, dof)``) and the state."""
+    its state (:func:`kcplan.arm.bounds.levers`, ``(bodies, dof)``), the state, and
+    whether each body's KC guard is clear (``(bodies,)``; None without the KC
+    certificate)."""
 
     scene: np.ndarray
     pairs: np.ndarray
     levers: np.ndarray
     state: np.ndarray
+    grown: np.ndarray | None = None
 
     @property
     def clearance(self) -> float:
@@ -118,10 +162,12 @@ class ArmEdgeCertifier:
     first_order : bool
         Bound the bodies' motion by their twist at the guard as well (module docstring);
         False: the levers alone (the ablation).
+    kc_inflation : float
+        The KC certificate's ``eps`` (module docstring); 0: the clearance ball alone
+        (the ``ca`` ablation).
     """
 
     backend = "python"
-    certificates = ("ball",)
 
     def __init__(
         self,
@@ -130,7 +176,12 @@ class ArmEdgeCertifier:
         cache_entries: int = 200_000,
         probes: bool = True,
         first_order: bool = True,
+        kc_inflation: float = 0.0,
     ):
+        if not (math.isfinite(kc_inflation) and kc_inflation >= 0.0):
+            raise ValueError(f"kc_inflation: expected a finite number >= 0, got {kc_inflation!r}")
+        self.kc_inflation = float(kc_inflation)
+        self.certificates = ("ball", "kc") if self.kc_inflation > 0 else ("ball",)
         self.world, self.arm = world, world.arm
         self.probes, self.first_order = bool(probes), bool(first_order)
         self.n = self.arm.dof
@@ -143,6 +194,7 @@ class ArmEdgeCertifier:
         self.cache = GuardCache(cache_entries)
         self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
         self.covered = {"ball": 0.0}
+        self._semi_axes = np.array([b.semi_axes for b in self.arm.bodies]).reshape(-1, 3)
         self.fallback = "bisection"
 
     def _joints(self, state: ArrayLike) -> np.ndarray:
@@ -170,7 +222,11 @@ class ArmEdgeCertifier:
 
     def _measure(self, q: np.ndarray) -> ArmGuard:
         self.counters["guards"] += 1
-        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q), q)
+        grown = None
+        if self.kc_inflation > 0:
+            self.counters["collision_queries"] += 1
+            grown = self.world.grown_clear(q, 1.0 + self.kc_inflation)
+        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q), q, grown)
 
     def _endpoint(self, q: np.ndarray) -> ArmGuard:
         key = q.tobytes()
@@ -194,24 +250,35 @@ class ArmEdgeCertifier:
         pair_growth = (growth[first] * only_first + growth[second] * only_second).sum(axis=1)
         accel = point_accelerations(self.arm, dq)
         return (self._rho @ dq, self._rho_pairs @ dq, dq, growth.sum(axis=1), pair_growth,
-                accel, q2 - q1)  # fmt: skip
+                accel, q2 - q1, turn_speeds(self.arm, dq))  # fmt: skip
 
     def _radius(self, guard: ArmGuard, terms: tuple) -> float:
         """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
         if guard.clearance <= 0.0:
             return 0.0
-        speed, pair_speed, dq, growth, pair_growth, accel, step = terms
+        speed, pair_speed, dq, growth, pair_growth, accel, step, turn = terms
         first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
         only_first, only_second = self._only
         L = guard.levers
         pair_levers = L[first] * only_first + L[second] * only_second
-        twist = None
-        if self.first_order:
-            twist = (first_order_speeds(self.arm, guard.state, step), accel)
-        r = min(
-            _reach(guard.scene, speed, L @ dq, growth, twist),
-            _reach(guard.pairs, pair_speed, pair_levers @ dq, pair_growth),
-        )
+        a = self._semi_axes
+        twist = velocity = None
+        if self.first_order or guard.grown is not None:
+            w, velocity = twists(self.arm, guard.state, step)
+            if self.first_order:
+                # kcplan.arm.bounds.first_order_speeds, from the twists already at hand
+                speeds = np.linalg.norm(velocity, axis=1) + np.linalg.norm(w, axis=1) * a.max(1)
+                twist = (speeds, accel)
+        bodies = _reaches(guard.scene, speed, L @ dq, growth, twist)
+        if guard.grown is not None:
+            rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
+            kc = _kc_reaches(
+                self.kc_inflation, guard.grown, a, rotations,
+                velocity if self.first_order else None, turn, speed, L @ dq, growth, accel,
+            )  # fmt: skip
+            bodies = np.fmax(bodies, kc)
+        pairs = _reaches(guard.pairs, pair_speed, pair_levers @ dq, pair_growth)
+        r = min(bodies.min(initial=math.inf), pairs.min(initial=math.inf))
         return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
 
     def _reject(self, reason: str) -> bool:
@@ -290,22 +357,52 @@ def _length(dq: np.ndarray) -> float:
     return math.sqrt(sum(float(d) * float(d) for d in dq))
 
 
-def _reach(
+def _reaches(
     d: np.ndarray, v: np.ndarray, A: np.ndarray, Q: np.ndarray, twist: tuple | None = None
-) -> float:
-    """The smallest radius clearances ``d`` give to parts of global speed ``v``, lever term
+) -> np.ndarray:
+    """The radius clearances ``d`` give to each part of global speed ``v``, lever term
     ``A`` and growth ``Q``: ``max(d / v, t)`` with ``A t + Q t^2 / 2 = d``, and with
     ``twist = (A1, M)`` the root of ``A1 t + M t^2 / 2 = d`` as well (module docs; ``inf``
-    for parts that do not move, and for none)."""
+    for a part that does not move)."""
+    t = np.full(len(d), math.inf)
     moving = v > 0
-    if not moving.any():
-        return math.inf
-    t = np.maximum(d[moving] / v[moving], _root(d[moving], A[moving], Q[moving]))
+    t[moving] = np.maximum(d[moving] / v[moving], _root(d[moving], A[moving], Q[moving]))
     if twist is not None:
         A1, M = twist
         with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.fmax(t, _root(d[moving], A1[moving], M[moving]))
-    return float(t.min())
+            t[moving] = np.fmax(t[moving], _root(d[moving], A1[moving], M[moving]))
+    return t
+
+
+def _kc_reaches(
+    eps: float,
+    grown: np.ndarray,
+    semi_axes: np.ndarray,
+    rotations: np.ndarray,
+    velocity: np.ndarray | None,
+    turn: np.ndarray,
+    v: np.ndarray,
+    A: np.ndarray,
+    Q: np.ndarray,
+    M: np.ndarray,
+) -> np.ndarray:
+    """The radius each body's KC guard gives it (module docstring, (KC)), 0 where that
+    guard is not clear: the largest ``t`` of ``(v + L w) t = eps a_min``, ``(A + L w) t + Q
+    t^2 / 2 = eps a_min`` and, with the centres' ``velocity`` at the guard (``(bodies,
+    3)``, world frame; ``rotations`` ``(bodies, 3, 3)`` the bodies' frames there),
+    ``(|diag(a)^-1 R^T u| + L w / a_min) t + M t^2 / (2 a_min) = eps``, with ``L = a_max -
+    a_min`` and ``w`` the bodies' ``turn`` speeds; shape ``(bodies,)``."""
+    a_min, a_max = semi_axes.min(axis=1), semi_axes.max(axis=1)
+    spin = (a_max - a_min) * turn
+    budget = eps * a_min
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(v + spin > 0, budget / (v + spin), math.inf)
+        t = np.fmax(t, _root(budget, A + spin, Q))
+        if velocity is not None:
+            local = np.einsum("kji,kj->ki", rotations, velocity) / semi_axes  # diag(a)^-1 R^T u
+            nu = np.linalg.norm(local, axis=1)
+            t = np.fmax(t, _root(eps, nu + spin / a_min, M / a_min))
+    return np.where(grown, t, 0.0)
 
 
 def _root(d: np.ndarray, A: np.ndarray, Q: np.ndarray) -> np.ndarray:

@@ -156,17 +156,20 @@ class KernelArmCertifier:
     first_order : bool
         Bound the bodies' motion by their twist at each guard as well
         (:mod:`kcplan.planning.arm_certifier`); False is the ablation.
+    kc_inflation : float
+        The KC certificate's ``eps`` (:mod:`kcplan.planning.arm_certifier`); 0: the
+        clearance ball alone (the ``ca`` ablation).
 
     Notes
     -----
     ``counters`` adds ``refined_pairs`` (self pairs whose bounding balls' gap limited a
-    guard's radius, so that coal measured their distance), ``refined_bodies`` and
-    ``skipped_groups`` (groups of pairs a radius decided by their links' balls). Not
-    thread-safe.
+    guard's radius, so that coal measured their distance), ``refined_bodies``,
+    ``skipped_groups`` (groups of pairs a radius decided by their links' balls),
+    ``grown_queries`` (KC guards asked) and ``kc_reaches`` (bodies whose KC guard took them
+    farther than their ball where a radius asked). Not thread-safe.
     """
 
     backend = "kernel"
-    certificates = ("ball",)
     fallback = "bisection"
 
     def __init__(
@@ -177,13 +180,15 @@ class KernelArmCertifier:
         probes: bool = True,
         part_balls: bool = True,
         first_order: bool = True,
+        kc_inflation: float = 0.0,
     ):
         self.world = world
         self.n = world.arm.dof
         self.compiled = _CompiledArmCertifier(
             world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls),
-            bool(first_order),
+            bool(first_order), float(kc_inflation),
         )  # fmt: skip
+        self.certificates = ("ball", "kc") if kc_inflation > 0 else ("ball",)
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have

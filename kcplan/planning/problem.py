@@ -534,9 +534,11 @@ def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | 
 
 def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     """The group's joint box (the limits); the covers' collision queries, compiled
-    (``backend="kernel"``, on coal) or on python-fcl. For arms the ``kc-*`` and ``ca-*``
-    planners both certify with the chain's clearance balls
-    (:mod:`kcplan.planning.arm_certifier`); stock planners check states discretely."""
+    (``backend="kernel"``, on coal) or on python-fcl. For arms the ``ca-*`` planners
+    certify with the chain's clearance balls, the other ``kc-*`` ones with the KC guards
+    as well (:mod:`kcplan.planning.arm_certifier`; inflation: the scenario's
+    ``robot.inflation``, else :data:`~kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`);
+    stock planners check states discretely."""
     arm = scenario.arm
     if world is None:
         world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
@@ -547,9 +549,12 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     validator = None
     n = arm.dof
     if spec.kc:
+        ball_only = spec.certificates == CERTIFICATE_SETS["ca"]
         validator = KCMotionValidator(
-            si, arm, world, backend=spec.backend, probes=spec.probes,
-            part_balls=spec.part_balls, first_order=spec.first_order,
+            si, arm, world, certificates=("ball",) if ball_only else ("ball", "kc"),
+            inflations=[scenario.inflation] if scenario.inflation > 0 else None,
+            backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls,
+            first_order=spec.first_order,
         )  # fmt: skip
         si.setMotionValidator(validator)
         state_valid = validator.state_valid

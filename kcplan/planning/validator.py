@@ -33,6 +33,7 @@ Contract (OMPL's, as far as the Python binding allows):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from numpy.typing import ArrayLike
@@ -40,7 +41,7 @@ from ompl import base as ob
 
 from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
-from kcplan.planning.arm_certifier import ArmEdgeCertifier
+from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
 from kcplan.planning.ladder import GuardLadder
@@ -68,14 +69,18 @@ class KCMotionValidator(ob.MotionValidator):
         :class:`kcplan.world.CollisionWorld`.
     certificates : sequence of str, optional
         Default ``("region",)``, or ``("rotation",)`` when the world has no
-        ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`.
+        ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`. For an
+        arm ``("ball", "kc")`` (the default: the chain's clearance balls and the KC
+        guards of :mod:`kcplan.planning.arm_certifier`) or ``("ball",)``.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
         validity-checking resolution.
     inflations : sequence of float, optional
         Guard inflation ladder of the ``polytope`` certificate (default
-        :data:`kcplan.planning.ladder.DEFAULT_LADDER`).
+        :data:`kcplan.planning.ladder.DEFAULT_LADDER`); for an arm one number, the KC
+        guards' inflation ``eps`` (default
+        :data:`kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`).
     horizon : float, optional
         Region horizon in length units (default the largest semi-axis).
     max_guards : int, optional
@@ -127,7 +132,7 @@ class KCMotionValidator(ob.MotionValidator):
         if isinstance(world, ArmWorld):
             self._init_arm(
                 robot, world, certificates, fallback, max_guards, backend, probes,
-                (part_balls, first_order),
+                (part_balls, first_order, inflations),
             )  # fmt: skip
             return
         max_guards = 64 if max_guards is None else max_guards
@@ -170,30 +175,37 @@ class KCMotionValidator(ob.MotionValidator):
     def _init_arm(
         self, arm, world, certificates, fallback, max_guards, backend, probes, options
     ) -> None:
-        part_balls, first_order = options
+        part_balls, first_order, inflations = options
         if arm is not world.arm:
             raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
         backend = "kernel" if backend is None else backend
         if backend not in ("kernel", "python"):
             raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
-        if certificates not in (None, ("ball",), ["ball"]) or fallback != "bisection":
+        chosen = None if certificates is None else tuple(certificates)
+        if chosen not in (None, ("ball",), ("ball", "kc")) or fallback != "bisection":
             raise ValueError(
-                "certificates: arms have the clearance ball ('ball', bisection) for now, "
-                f"got {certificates!r} with {fallback!r}"
+                "certificates: arms have ('ball', 'kc') (the default) and ('ball',), with "
+                f"bisection; got {certificates!r} with {fallback!r}"
             )
+        kc_inflation = 0.0
+        if chosen != ("ball",):
+            kc_inflation = DEFAULT_KC_INFLATION if not inflations else float(inflations[0])
+            if not (math.isfinite(kc_inflation) and kc_inflation > 0.0):
+                raise ValueError(f"inflations: expected a KC inflation > 0, got {inflations!r}")
         max_guards = 256 if max_guards is None else max_guards
         if backend == "kernel":
             self.certifier = KernelArmCertifier(
                 world, max_guards, probes=probes > 0, part_balls=part_balls,
-                first_order=first_order,
+                first_order=first_order, kc_inflation=kc_inflation,
             )  # fmt: skip
             # the hot path: one call into the kernel with the joint vector(s)
             self.state_valid = self._valid_kernel_arm
             self.checkMotion = self._check_kernel_arm
         else:
             self.certifier = ArmEdgeCertifier(
-                world, max_guards, probes=probes > 0, first_order=first_order
-            )
+                world, max_guards, probes=probes > 0, first_order=first_order,
+                kc_inflation=kc_inflation,
+            )  # fmt: skip
         self.backend = backend
         self.n = arm.dof
         self._read = lambda state, n=arm.dof: joint_state(state, n)
