@@ -18,6 +18,8 @@ from kcplan.arm.bounds import (
     levers,
     point_accelerations,
     point_speeds,
+    relative_accelerations,
+    relative_first_order,
     relative_speeds,
 )
 from kcplan.arm.kinematics import body_frames
@@ -143,6 +145,40 @@ def test_first_order_bounds_hold_and_are_the_kernels(panda, world, states):
         ratios.extend(A1[moving] / (levers(panda, qm) @ np.abs(step))[moving])
     assert worst <= 1e-12
     assert np.median(ratios) < 0.8  # the twist's joint terms partly cancel
+
+
+def test_relative_first_order_bounds_the_pairs_and_is_the_kernels(panda, world, states):
+    """Within t of a guard, the distance between any sampled surface point of one body of a
+    self pair and any of the other changes by at most A1 t + M t^2 / 2 (the pair's
+    relative first order, kcplan.arm.bounds), on either side, where the bodies' own
+    (world-frame) first order would not do; the kernel computes the same A1 and M."""
+    u = np.random.default_rng(6).normal(size=(60, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    pairs = world.self_pairs
+    worst, tighter = -np.inf, 0
+    for q1, q2 in zip(states[60:72], states[61:73], strict=True):
+        step, m = q2 - q1, 0.4
+        qm = q1 + m * step
+        A1 = relative_first_order(panda, qm, step, pairs)
+        M = relative_accelerations(panda, np.abs(step), pairs)
+        np.testing.assert_allclose(world.kernel.pair_first_order(qm.tolist(), step.tolist()),
+                                   np.stack([A1, M], axis=1), rtol=1e-9, atol=1e-15)  # fmt: skip
+        own = first_order_speeds(panda, qm, step)
+        tighter += (A1 < own[pairs[:, 0]] + own[pairs[:, 1]] - 1e-9).sum()
+        placed = [(u * b.semi_axes) @ f[:3, :3].T + f[:3, 3]
+                  for b, f in zip(panda.bodies, body_frames(panda, qm), strict=True)]  # fmt: skip
+        for t in (0.01, 0.1, 0.4):
+            for s in (m - t, m + t):
+                moved = [(u * b.semi_axes) @ f[:3, :3].T + f[:3, 3]
+                         for b, f in zip(panda.bodies, body_frames(panda, q1 + s * step),
+                                         strict=True)]  # fmt: skip
+                for row, (k, j) in enumerate(pairs):
+                    before = np.linalg.norm(placed[k][:, None] - placed[j][None], axis=2)
+                    after = np.linalg.norm(moved[k][:, None] - moved[j][None], axis=2)
+                    change = np.abs(after - before).max()
+                    worst = max(worst, change - (A1[row] * t + M[row] * t * t / 2))
+    assert worst <= 1e-12
+    assert tighter > 0.5 * 12 * len(pairs)  # the joints both carry drop out
 
 
 def test_kernel_and_python_agree_on_every_state(world, states):

@@ -22,7 +22,8 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
       rho_pairs_(world.chain().relative_speeds(world.pairs())),
-      rho_groups_(world.parts().relative_speeds(world.groups())) {
+      rho_groups_(world.parts().relative_speeds(world.groups())),
+      pair_first_(world.chain(), world.pairs()) {
   if (max_guards_ < 1) throw std::invalid_argument("max_guards: expected at least 1");
   if (!(kc_ >= 0.0) || !std::isfinite(kc_))
     throw std::invalid_argument("kc_inflation: expected a finite number >= 0");
@@ -146,6 +147,14 @@ void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double
   Q = pair_growth_[m];
 }
 
+double ArmCertifier::pair_reach(const ArmGuard& guard, std::size_t m, double d, double enough) {
+  double A, Q;
+  terms(guard, speed_.size() + m, A, Q);
+  const double t = reach(d, pair_speed_[m], A, Q);
+  if (!first_order_ || t >= enough) return t;  // the first order could only add to it
+  return std::max(t, root(d, pair_first_.speed(m), pair_first_.accel(m)));
+}
+
 void ArmCertifier::pair_terms(std::size_t m) const {
   if (pair_edge_[m] == edge_) return;
   pair_edge_[m] = edge_;
@@ -196,15 +205,13 @@ void ArmCertifier::pair_radius(const ArmGuard& guard, std::size_t m, double enou
     guard.pairs[m] = std::max(world_.pair_gap(m, frames()), 0.0);
     guard.pair_known[m] = 1;
   }
-  double A, Q;
-  terms(guard, speed_.size() + m, A, Q);
-  double t = reach(guard.pairs[m], v, A, Q);
+  double t = pair_reach(guard, m, guard.pairs[m], std::min(r, enough));
   if (guard.pair_known[m] == 1 && t < std::min(r, enough)) {
     guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
     guard.pair_known[m] = 2;
     ++refined_pairs;
     if (!(guard.pairs[m] > 0.0)) guard.clearance = 0.0;  // in contact: the state is not free
-    t = reach(guard.pairs[m], v, A, Q);
+    t = pair_reach(guard, m, guard.pairs[m], std::min(r, enough));
   }
   r = std::min(r, t);
 }
@@ -311,6 +318,7 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   const std::size_t bodies = speed_.size();
   double r = std::numeric_limits<double>::infinity();
   if (first_order_ || kc_ > 0.0) twist(guard);  // the bodies' twists here, for this edge
+  if (first_order_) pair_first_.guard(guard.joints, guard.centres.data());
   bool placed = false;
   const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
     if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
@@ -367,6 +375,7 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
   chain_.lever_growth(dq_.data(), growth_.data());
   if (first_order_ || kc_ > 0.0) chain_.point_accelerations(dq_.data(), accel_.data());
   if (kc_ > 0.0) chain_.turn_speeds(dq_.data(), turn_.data());
+  if (first_order_) pair_first_.edge(step_.data());
   ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_terms)
   if (part_balls_) {
     const Chain& parts = world_.parts();

@@ -12,6 +12,7 @@
 #include "arm_world.hpp"
 #include "certifier.hpp"
 #include "guard.hpp"
+#include "pair_motion.hpp"
 
 namespace kcplan {
 
@@ -75,9 +76,10 @@ struct ArmCertifierOptions {
 /// with A from the levers at q(m) and Q from how fast they can grow (Chain::levers,
 /// Chain::lever_growth), nor, for a body (first_order), farther than A1 t + M t^2 / 2 with
 /// A1 from its twist at q(m) and M its largest acceleration (Chain::first_order_speeds,
-/// Chain::point_accelerations). A guard with clearances d_k and d_kl therefore proves the
-/// open stretch |s - m| < r free, r the smallest over bodies and pairs of
-/// max(d / v, the root t of A t + Q t^2 / 2 = d, for a body that of A1 t + M t^2 / 2 = d):
+/// Chain::point_accelerations), and for a pair the same of both bodies in the frame of the
+/// joints that carry both (PairFirstOrder). A guard with clearances d_k and d_kl therefore
+/// proves the open stretch |s - m| < r free, r the smallest over bodies and pairs of
+/// max(d / v, the root t of A t + Q t^2 / 2 = d, that of A1 t + M t^2 / 2 = d):
 /// each body stays clear of the scene and of each body it may collide with, and the
 /// covers hold the links.
 /// kcplan/planning/arm_certifier.py has the proof in full.
@@ -187,6 +189,10 @@ class ArmCertifier {
                    Frames& frames);
   /// The bodies' twists at `guard` for the current edge (w_, u_) and first_.
   void twist(const ArmGuard& guard);
+  /// Pair m's radius from the distance d at the guard of the current radius(): reach,
+  /// and (first_order, where reach is below `enough`) the root of its relative first
+  /// order (PairFirstOrder).
+  double pair_reach(const ArmGuard& guard, std::size_t m, double d, double enough);
   /// A and Q of body k (k < bodies) or of pair k - bodies, for the current edge.
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
   /// The radius group g's gap gives all its pairs, for the current edge.
@@ -206,6 +212,7 @@ class ArmCertifier {
   std::vector<double> speed_, q_, caps_, dq_, growth_, step_, accel_;
   mutable std::vector<double> first_;  // A1 of the bodies at the guard of the radius asked
   std::vector<coal::Vec3s> w_, u_;     // their twists there (twist())
+  PairFirstOrder pair_first_;          // the pairs' first order (first_order)
   std::vector<double> turn_;           // per body: Chain::turn_speeds of the edge
   /// Self pair m's speed and growth for the current edge, computed when first needed.
   void pair_terms(std::size_t m) const;

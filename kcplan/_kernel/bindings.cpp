@@ -337,6 +337,22 @@ NB_MODULE(_core, m) {
         w.safe_clearances(joints_of(w.chain(), q), scene.data(), pairs.data());
         return nb::make_tuple(scene, pairs);
       }, "q"_a)
+      .def("pair_first_order", [](kcplan::ArmWorld& w, const std::vector<double>& q,
+                                  const std::vector<double>& dq) {
+        const kcplan::Chain& chain = w.chain();
+        std::vector<coal::Transform3s> joints, frames;
+        chain.body_frames(joints_of(chain, q), joints, frames);
+        std::vector<double> centres;
+        for (const coal::Transform3s& f : frames)
+          for (int i = 0; i < 3; ++i) centres.push_back(f.getTranslation()[i]);
+        kcplan::PairFirstOrder first(chain, w.pairs());
+        first.edge(joints_of(chain, dq));
+        first.guard(joints, centres.data());
+        std::vector<std::array<double, 2>> out;
+        for (std::size_t m = 0; m < w.pairs().size(); ++m)
+          out.push_back({first.speed(m), first.accel(m)});
+        return out;
+      }, "q"_a, "dq"_a)
       .def("grown_clear", [](kcplan::ArmWorld& w, const std::vector<double>& q, double scale) {
         const std::vector<coal::Transform3s>& frames = w.place(joints_of(w.chain(), q));
         std::vector<bool> out(frames.size());

@@ -172,11 +172,9 @@ void Chain::lever_growth(const double* dq, double* out) const {
   }
 }
 
-void Chain::twists(const std::vector<coal::Transform3s>& joints, const double* centres,
-                   const double* dq, std::vector<coal::Vec3s>& w_out,
-                   std::vector<coal::Vec3s>& u_out) const {
-  // per joint frame: its angular velocity w and u, the velocity of a point x being w x x + u
-  std::vector<coal::Vec3s> w(joints_.size() + 1, coal::Vec3s::Zero()), u = w;
+void Chain::joint_twists(const std::vector<coal::Transform3s>& joints, const double* dq,
+                         std::vector<coal::Vec3s>& w, std::vector<coal::Vec3s>& u) const {
+  w.assign(joints_.size() + 1, coal::Vec3s::Zero()), u = w;
   for (std::size_t i = 1; i <= joints_.size(); ++i) {
     const ChainJoint& joint = joints_[i - 1];
     w[i] = w[joint.parent], u[i] = u[joint.parent];
@@ -189,6 +187,13 @@ void Chain::twists(const std::vector<coal::Transform3s>& joints, const double* c
       u[i] -= step * axis.cross(joints[i].getTranslation());
     }
   }
+}
+
+void Chain::twists(const std::vector<coal::Transform3s>& joints, const double* centres,
+                   const double* dq, std::vector<coal::Vec3s>& w_out,
+                   std::vector<coal::Vec3s>& u_out) const {
+  std::vector<coal::Vec3s> w, u;
+  joint_twists(joints, dq, w, u);
   w_out.resize(bodies_.size()), u_out.resize(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     const int i = bodies_[k].joint;
@@ -214,26 +219,32 @@ void Chain::turn_speeds(const double* dq, double* out) const {
   }
 }
 
-void Chain::point_accelerations(const double* dq, double* out) const {
-  const std::size_t dof = lower_.size();
-  std::vector<double> turning(joints_.size() + 1, 0.0);  // S: revolute steps above each joint
+void Chain::axis_turns(const double* dq, std::vector<double>& S) const {
+  S.assign(joints_.size() + 1, 0.0);
   for (std::size_t i = 1; i <= joints_.size(); ++i) {
     const int parent = joints_[i - 1].parent;
-    turning[i] = turning[parent];
-    if (parent > 0 && !joints_[parent - 1].prismatic)
-      turning[i] += std::abs(dq[joints_[parent - 1].state]);
+    S[i] = S[parent];
+    if (parent > 0 && !joints_[parent - 1].prismatic) S[i] += std::abs(dq[joints_[parent - 1].state]);
   }
-  for (std::size_t k = 0; k < bodies_.size(); ++k) {
-    double below = 0.0, M = 0.0;
-    for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {
-      const ChainJoint& joint = joints_[i - 1];
-      const double step = std::abs(dq[joint.state]);
-      below += step * rho_[k * dof + joint.state];
-      M += joint.prismatic ? step * turning[i]
-                           : step * (2.0 * turning[i] * rho_[k * dof + joint.state] + below);
-    }
-    out[k] = M * (1.0 + 1e-12);
+}
+
+double Chain::point_acceleration(std::size_t k, const double* dq,
+                                 const std::vector<double>& S) const {
+  const std::size_t dof = lower_.size();
+  double below = 0.0, M = 0.0;
+  for (int i = bodies_[k].joint; i > 0; i = joints_[i - 1].parent) {
+    const ChainJoint& joint = joints_[i - 1];
+    const double step = std::abs(dq[joint.state]);
+    below += step * rho_[k * dof + joint.state];
+    M += joint.prismatic ? step * S[i] : step * (2.0 * S[i] * rho_[k * dof + joint.state] + below);
   }
+  return M * (1.0 + 1e-12);  // and rounding
+}
+
+void Chain::point_accelerations(const double* dq, double* out) const {
+  std::vector<double> S;
+  axis_turns(dq, S);
+  for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = point_acceleration(k, dq, S);
 }
 
 std::vector<double> Chain::relative_speeds(const std::vector<std::array<int, 2>>& pairs) const {

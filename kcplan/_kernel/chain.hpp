@@ -100,6 +100,16 @@ class Chain {
   /// (3 numbers per body) there. first_order_speeds is |u| + |w| a_max of these.
   void twists(const std::vector<coal::Transform3s>& joints, const double* centres,
               const double* dq, std::vector<coal::Vec3s>& w, std::vector<coal::Vec3s>& u) const;
+  /// The twist of every joint's frame at one q along the signed step `dq`: w[i] its
+  /// angular velocity and u[i] such that a point x fixed to it moves at w[i] x x + u[i]
+  /// (joint_count() of each, the universe's 0); twists() reads the bodies' off these.
+  void joint_twists(const std::vector<coal::Transform3s>& joints, const double* dq,
+                    std::vector<coal::Vec3s>& w, std::vector<coal::Vec3s>& u) const;
+  /// S[i]: the sum of |dq| over the revolute joints above joint i, how fast its axis
+  /// turns at most (joint_count() numbers; point_accelerations' S_j).
+  void axis_turns(const double* dq, std::vector<double>& S) const;
+  /// point_accelerations of body k alone, given axis_turns(dq) = S.
+  double point_acceleration(std::size_t k, const double* dq, const std::vector<double>& S) const;
   /// out[k] = the sum of |dq_j| over the revolute joints j that carry body k: how far body
   /// k turns at most per unit of the edge parameter, anywhere along the edge (radians;
   /// kcplan/arm/bounds.py turn_speeds).

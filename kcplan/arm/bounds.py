@@ -68,9 +68,21 @@ its integral remainder, within ``t`` of ``m``
 
     |x(s) - x(m)| <= A1_k t + M_k t^2 / 2.
 
+*Relative first order* (self pairs). The joints that carry both bodies of a pair ``(k,
+l)`` (the deepest of them ``J`` and the joints above it) move them as one rigid body. In
+``J``'s frame every point of body ``k`` is a function of the other joints alone: the chain
+from ``J`` down, as if ``J`` were fixed. So the first-order bound above, computed with the
+steps of the joints that carry both set to 0, ``A1_k^J`` and ``M_k^J``
+(:func:`relative_first_order`, :func:`relative_accelerations`), bounds how far a point of
+``k`` moves in ``J``'s frame, and the same of ``l``; distances are the same in every frame,
+so within ``t`` of ``m`` the distance between any point of ``k`` and any point of ``l``
+changes by at most
+
+    (A1_k^J + A1_l^J) t + (M_k^J + M_l^J) t^2 / 2.
+
 These are the bounds of the clearance-ball certificate for arms: a body whose clearance
 ``d`` at ``q(m)`` exceeds ``min(v t, A t + Q t^2 / 2, A1 t + M t^2 / 2)`` stays free within
-``t`` (pairs take the first two).
+``t``, and so does a pair with its own terms.
 """
 
 from __future__ import annotations
@@ -92,6 +104,8 @@ __all__ = [
     "chain_speeds",
     "pair_speeds",
     "point_speeds",
+    "relative_accelerations",
+    "relative_first_order",
     "relative_speeds",
     "speeds",
     "turn_speeds",
@@ -168,6 +182,50 @@ def relative_speeds(
     ``(len(pairs), dof)``."""
     first, second = pairs[:, 0], pairs[:, 1]
     return rho[first] * (C[first] & ~C[second]) + rho[second] * (C[second] & ~C[first])
+
+
+def _common_masks(C: NDArray[np.bool_], pairs: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
+    """The distinct sets of joints that carry both bodies of a pair (rows of ``(masks,
+    dof)``, True: carries both) and each pair's row, ``(len(pairs),)``."""
+    common = C[pairs[:, 0]] & C[pairs[:, 1]]
+    masks, which = np.unique(common.reshape(len(pairs), -1), axis=0, return_inverse=True)
+    return masks.reshape(-1, C.shape[1]), which.reshape(-1)
+
+
+def relative_first_order(
+    arm: ArmModel, state: Sequence[float], dq: Sequence[float], pairs: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """``A1_k^J + A1_l^J`` of each self pair ``(k, l) = pairs[m]`` at ``state`` along the
+    signed joint step ``dq``: the first-order speeds of both bodies in the frame of the
+    joints that carry both (module docstring, *Relative first order*); shape
+    ``(len(pairs),)``, metres per unit of the edge parameter."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    masks, which = _common_masks(carries(arm), pairs)
+    step = np.asarray(dq, dtype=float)
+    out = np.zeros(len(pairs))
+    for row, mask in enumerate(masks):
+        speeds = first_order_speeds(arm, state, np.where(mask, 0.0, step))
+        chosen = which == row
+        out[chosen] = speeds[pairs[chosen, 0]] + speeds[pairs[chosen, 1]]
+    return out
+
+
+def relative_accelerations(
+    arm: ArmModel, dq: Sequence[float], pairs: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """``M_k^J + M_l^J`` of each self pair ``(k, l) = pairs[m]`` for joint steps ``|dq|``:
+    the largest accelerations of both bodies' points in the frame of the joints that carry
+    both, anywhere along the edge (module docstring, *Relative first order*); shape
+    ``(len(pairs),)``."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    masks, which = _common_masks(carries(arm), pairs)
+    step = np.abs(np.asarray(dq, dtype=float))
+    out = np.zeros(len(pairs))
+    for row, mask in enumerate(masks):
+        accel = point_accelerations(arm, np.where(mask, 0.0, step))
+        chosen = which == row
+        out[chosen] = accel[pairs[chosen, 0]] + accel[pairs[chosen, 1]]
+    return out
 
 
 def pair_speeds(

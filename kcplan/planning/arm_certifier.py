@@ -13,11 +13,13 @@ takes the joints that carry one of its bodies only); nor, for a body, farther th
 ``A1 t + M t^2 / 2``, with ``A1`` from its exact twist at ``q(m)`` and ``M`` its largest
 acceleration along the edge (:func:`kcplan.arm.bounds.first_order_speeds`,
 :func:`kcplan.arm.bounds.point_accelerations`: Taylor's theorem with its remainder; the
-twist's joint contributions partly cancel, so ``A1`` is about half of ``A``). So for
-``|s - m| < r`` with
+twist's joint contributions partly cancel, so ``A1`` is about half of ``A``); a pair takes
+the same terms of both bodies in the frame of the joints that carry both
+(:func:`kcplan.arm.bounds.relative_first_order`,
+:func:`kcplan.arm.bounds.relative_accelerations`). So for ``|s - m| < r`` with
 
     r = min over bodies and pairs of max( d / v , t , t1 ),
-        A t + Q t^2 / 2 = d,  A1 t1 + M t1^2 / 2 = d  (t1 = 0 for a pair)
+        A t + Q t^2 / 2 = d,  A1 t1 + M t1^2 / 2 = d
 
 every body stays clear of every obstacle (it was ``d_k`` away and moved less than
 ``d_k``) and of every body it may collide with: the stretch ``(m - r, m + r)`` is free.
@@ -79,6 +81,8 @@ from kcplan.arm.bounds import (
     levers,
     point_accelerations,
     point_speeds,
+    relative_accelerations,
+    relative_first_order,
     relative_speeds,
     turn_speeds,
     twists,
@@ -241,22 +245,24 @@ class ArmEdgeCertifier:
 
     def _terms(self, q1: np.ndarray, q2: np.ndarray) -> tuple:
         """What a guard's radius needs of the edge: the global speeds of the bodies and
-        pairs, ``|dq|``, the growth terms ``Q`` of bodies and pairs, the bodies' largest
-        accelerations ``M`` and the signed step (module docs)."""
+        pairs, ``|dq|``, the growth terms ``Q`` of bodies and pairs, the largest accelerations
+        ``M`` of bodies and pairs, the signed step and the bodies' turn speeds (module
+        docs)."""
         dq = np.abs(q2 - q1)
         growth = lever_growth(self.arm, dq)
         first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
         only_first, only_second = self._only
         pair_growth = (growth[first] * only_first + growth[second] * only_second).sum(axis=1)
         accel = point_accelerations(self.arm, dq)
+        pair_accel = relative_accelerations(self.arm, dq, self.world.self_pairs)
         return (self._rho @ dq, self._rho_pairs @ dq, dq, growth.sum(axis=1), pair_growth,
-                accel, q2 - q1, turn_speeds(self.arm, dq))  # fmt: skip
+                (accel, pair_accel), q2 - q1, turn_speeds(self.arm, dq))  # fmt: skip
 
     def _radius(self, guard: ArmGuard, terms: tuple) -> float:
         """The half width, in ``s``, of the stretch a guard proves free (module docs)."""
         if guard.clearance <= 0.0:
             return 0.0
-        speed, pair_speed, dq, growth, pair_growth, accel, step, turn = terms
+        speed, pair_speed, dq, growth, pair_growth, (accel, pair_accel), step, turn = terms
         first, second = self.world.self_pairs[:, 0], self.world.self_pairs[:, 1]
         only_first, only_second = self._only
         L = guard.levers
@@ -277,7 +283,11 @@ class ArmEdgeCertifier:
                 velocity if self.first_order else None, turn, speed, L @ dq, growth, accel,
             )  # fmt: skip
             bodies = np.fmax(bodies, kc)
-        pairs = _reaches(guard.pairs, pair_speed, pair_levers @ dq, pair_growth)
+        pair_twist = None
+        if self.first_order:
+            pairs = self.world.self_pairs
+            pair_twist = (relative_first_order(self.arm, guard.state, step, pairs), pair_accel)
+        pairs = _reaches(guard.pairs, pair_speed, pair_levers @ dq, pair_growth, pair_twist)
         r = min(bodies.min(initial=math.inf), pairs.min(initial=math.inf))
         return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
 
