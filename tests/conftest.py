@@ -5,6 +5,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import settings
 from hypothesis import strategies as st
 
@@ -63,6 +64,22 @@ def panda_arm(bodies_per_link: int):
         PANDA / "panda.urdf", PANDA_GROUP, srdf=PANDA / "panda.srdf",
         bodies_per_link=bodies_per_link,
     )  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def panda(request):
+    """The bundled Panda for an arm test module: its ``BODIES_PER_LINK`` (default 2)
+    ellipsoids per link (:func:`panda_arm`)."""
+    return panda_arm(getattr(request.module, "BODIES_PER_LINK", 2))
+
+
+@pytest.fixture(scope="module")
+def world(panda, request):
+    """``panda`` in the arm tests' scene (:data:`ARM_SCENE`) and the module's
+    ``EXTRA_OBSTACLES``, if any."""
+    from kcplan.arm import ArmWorld
+
+    return ArmWorld(panda, (*arm_obstacles(), *getattr(request.module, "EXTRA_OBSTACLES", ())))
 
 
 # two of the Panda's covering ellipsoids (K = 4) at a state of box_1, frames [R | t] and

@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import PANDA, arm_obstacles, panda_arm
+from conftest import PANDA
 from conftest import PANDA_GROUP as GROUP
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from kcplan.arm import ArmError, ArmWorld, load_arm
+from kcplan.arm import ArmError, load_arm
 from kcplan.arm.scenario import parse_arm_scenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ArmEdgeCertifier
@@ -31,14 +31,7 @@ MARGINS = [1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e100, 1e308]
 FUZZ = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
-@pytest.fixture(scope="module")
-def panda():
-    return panda_arm(bodies_per_link=1)
-
-
-@pytest.fixture(scope="module")
-def world(panda):
-    return ArmWorld(panda, arm_obstacles())
+BODIES_PER_LINK = 1  # conftest.panda
 
 
 @pytest.fixture(scope="module")

@@ -5,9 +5,7 @@ decisions are the same in both twins; accepted edges are free on the links' mesh
 
 import numpy as np
 import pytest
-from conftest import arm_obstacles, panda_arm
 
-from kcplan.arm import ArmWorld
 from kcplan.arm.bounds import (
     lever_growth,
     levers,
@@ -22,16 +20,6 @@ from kcplan.planning.arm_certifier import ArmEdgeCertifier, _kc_reaches
 from kcplan.planning.kernel import KernelArmCertifier
 
 EPS = 0.2
-
-
-@pytest.fixture(scope="module")
-def panda():
-    return panda_arm(bodies_per_link=2)
-
-
-@pytest.fixture(scope="module")
-def world(panda):
-    return ArmWorld(panda, arm_obstacles())
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import fcl
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import AXES_A, AXES_B, FRAME_A, FRAME_B, arm_obstacles, panda_arm
+from conftest import AXES_A, AXES_B, FRAME_A, FRAME_B
 from scipy.spatial.transform import Rotation
 
 from kcplan.arm import ArmWorld
@@ -34,18 +34,7 @@ CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
 )  # fmt: skip
 
 
-def _obstacles():
-    return (*arm_obstacles(), CYLINDER)
-
-
-@pytest.fixture(scope="module")
-def panda():
-    return panda_arm(bodies_per_link=2)
-
-
-@pytest.fixture(scope="module")
-def world(panda):
-    return ArmWorld(panda, _obstacles())
+EXTRA_OBSTACLES = (CYLINDER,)  # beside the arm tests' scene (conftest.world)
 
 
 @pytest.fixture(scope="module")

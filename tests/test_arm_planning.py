@@ -11,7 +11,7 @@ from ompl import geometric as og
 
 from kcplan.arm import ArmWorld
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
+from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
 from kcplan.planning.states import joint_space, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
@@ -120,3 +120,23 @@ def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
     check = verify_arm_path(panda, obstacles, states)
     assert not check.collides and check.queries > len(states)
     assert mv.counters["edges"] > 0 and mv.counters["rejected"] < mv.counters["edges"]
+
+
+def test_the_validator_chooses_the_arm_certificates(panda, scene):
+    """An arm's validator certifies with the clearance ball and the KC guards by default
+    (kc-*), with the ball alone for certificates=("ball",) (ca-*); anything else, or an
+    inflation that is not a positive number, is one clear ValueError."""
+    world, _ = scene
+    si = ob.SpaceInformation(joint_space(panda.lower, panda.upper))
+    default = KCMotionValidator(si, panda, world)
+    assert default.certifier.certificates == ("ball", "kc")
+    assert default.certifier.compiled.kc_inflation == DEFAULT_KC_INFLATION
+    ball = KCMotionValidator(si, panda, world, certificates=("ball",))
+    assert ball.certifier.certificates == ("ball",) and ball.certifier.compiled.kc_inflation == 0
+    python = KCMotionValidator(si, panda, world, backend="python", inflations=[0.3])
+    assert python.certifier.kc_inflation == 0.3
+    with pytest.raises(ValueError, match=r"certificates: arms have \('ball', 'kc'\)"):
+        KCMotionValidator(si, panda, world, certificates=("region",))
+    for bad in ([0.0], [-1.0], [float("nan")]):
+        with pytest.raises(ValueError, match="inflations: expected a KC inflation > 0"):
+            KCMotionValidator(si, panda, world, inflations=bad)
