@@ -8,7 +8,9 @@ state), ``q'`` uniform in the limits and ``q2 = q1 + t (q' - q1)`` with ``t`` lo
 in ``[0.01, 1]``. The joints outside the group (fingers) are fixed at the first problem's
 start values. Each edge is decided by the compiled certifier
 (:class:`kcplan.planning.kernel.KernelArmCertifier`) and, for the first ``--twin`` edges,
-also by its Python twin (:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`).
+also by its Python twin (:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`), both
+with the certificates of the ``kc-*`` planners (the clearance balls and the KC guards of
+inflation ``--kc-inflation``; 0: the balls alone, as ``ca-*``).
 
 Every **accepted** edge (of either backend) is re-checked by the gap-free mesh verifier
 (:func:`kcplan.arm.verify.verify_arm_path`: the links' own collision meshes, python-fcl,
@@ -22,6 +24,7 @@ stderr; a Markdown table on stdout::
 
     python scripts/arm_soundness.py [--robot panda] [--edges 100000] [--seed 1]
         [--per-class 100] [--bodies 2] [--max-offset D] [--twin 0] [--free-check 0.05]
+        [--kc-inflation 0.2]
 
 The arm's links are covered by ``--bodies`` ellipsoids each (2 by default: fast to fit
 and to check), or with ``--max-offset D`` as :func:`kcplan.arm.load_arm` covers them by
@@ -43,7 +46,7 @@ import numpy as np
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.arm_certifier import ArmEdgeCertifier
+from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -99,7 +102,8 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
           f"ready in {time.perf_counter() - t0:.1f} s", file=out, flush=True)  # fmt: skip
     c = {"edges": 0, "accepted": 0, "violations": 0, "verified": 0, "twin": 0,
          "twin_accepted": 0, "twin_violations": 0, "twin_disagree": 0,
-         "decide_s": 0.0, "verify_s": 0.0, "twin_s": 0.0}  # fmt: skip
+         "decide_s": 0.0, "verify_s": 0.0, "twin_s": 0.0, "grown_queries": 0,
+         "kc_reaches": 0}  # fmt: skip
     steps = {name: {"rejected": 0, "checked": 0, "free": 0} for name in STEPS}
     per_problem = math.ceil(args.edges / len(chosen))
     start = time.perf_counter()
@@ -107,14 +111,18 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
         if k % per_problem == 0:
             problem = chosen[(k // per_problem) % len(chosen)]
             world = ArmWorld(arm, problem.obstacles, allowed=problem.allowed)
-            kernel = KernelArmCertifier(world)
-            twin = ArmEdgeCertifier(world) if k < args.twin else None
+            kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation)
+            twin = None
+            if k < args.twin:
+                twin = ArmEdgeCertifier(world, kc_inflation=args.kc_inflation)
         q1, q2 = _edge(rng, arm, kernel)
         before = dict(kernel.counters)
         t = time.perf_counter()
         ok = kernel.check(q1, q2)
         c["decide_s"] += time.perf_counter() - t
         c["edges"] += 1
+        for name in ("grown_queries", "kc_reaches"):  # what the KC guards did
+            c[name] += kernel.counters[name] - before[name]
         verdict = None
         verified = functools.partial(_collides, arm, problem, q1, q2, c)
         if ok:
@@ -188,12 +196,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--twin", type=int, default=0, help="edges also decided in Python")
     parser.add_argument("--free-check", type=float, default=0.05,
                         help="fraction of rejected edges verified on the meshes")  # fmt: skip
+    parser.add_argument("--kc-inflation", type=float, default=DEFAULT_KC_INFLATION,
+                        help="the KC guards' inflation (0: the clearance balls alone)")  # fmt: skip
     parser.add_argument("--mbm", default=os.fspath(MBM), help="folder of the MBM robots")
     args = parser.parse_args(argv)
     if args.bodies is None and args.max_offset is None:
         args.bodies = 2
     if args.edges < 1 or args.per_class < 1 or not 0.0 <= args.free_check <= 1.0:
         parser.error("expected --edges >= 1, --per-class >= 1, 0 <= --free-check <= 1")
+    if not (math.isfinite(args.kc_inflation) and args.kc_inflation >= 0.0):
+        parser.error("expected --kc-inflation >= 0")
     r = study(args)
     c, steps = r["counts"], r["steps"]
     verify_per = 1e3 * c["verify_s"] / max(c["verified"], 1)
@@ -217,7 +229,8 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(
         f"- {r['problems']} problems ({args.per_class} per class), {r['arm'].describe()}, "
-        f"seed {args.seed}"
+        f"seed {args.seed}; KC inflation {args.kc_inflation}: {c['grown_queries']} KC guards "
+        f"asked, {c['kc_reaches']} took a body farther than its ball"
     )
     print(f"- wall {c['wall_s']:.0f} s; kernel {1e6 * c['decide_s'] / c['edges']:.0f} us per "
           f"edge; mesh verification {verify_per:.1f} ms per edge ({c['verified']} verified)"

@@ -141,6 +141,7 @@ CASES = [
             r"^\| robot \| backend \| edges \| accepted \| violations \| rejected: end state ",
             r"^\| panda \| kernel \| 14 \| \d+ \| 0 \| \d+ / \d+ / \d+ / \d+ \| ",
             r"^\| panda \| python \| 4 \| \d+ \| 0 \| ",
+            r"KC inflation 0.2: \d+ KC guards asked, \d+ took a body farther than its ball$",
             rf"mesh verification {NUMBER} ms per edge",
         ),
     ),
