@@ -123,12 +123,35 @@ void ArmWorld::scene_clearances(double* out, const double* caps) {
     out[k] = part_caps_[part_of_[k]] > 0.0 ? caps[k] : scene_->capped_clearance(k, caps[k]);
 }
 
+namespace {
+
+/// |diag(a) R^T n|: the half width of the ellipsoid of semi-axes a, turned by R, along the
+/// unit n (its support function about its centre).
+double half_width(const ChainBody& body, const coal::Transform3s& frame, const coal::Vec3s& n) {
+  const coal::Vec3s local = frame.getRotation().transpose() * n;
+  const std::array<double, 3>& a = body.semi_axes;
+  return std::sqrt(a[0] * a[0] * local[0] * local[0] + a[1] * a[1] * local[1] * local[1] +
+                   a[2] * a[2] * local[2] * local[2]);
+}
+
+}  // namespace
+
 double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
   const auto [k, l] = pairs_[m];
   const ChainBody &a = chain_.bodies()[k], &b = chain_.bodies()[l];
-  const double centres = (frames[k].getTranslation() - frames[l].getTranslation()).norm();
+  const coal::Vec3s between = frames[l].getTranslation() - frames[k].getTranslation();
+  const double centres = between.norm();
+  // Along any unit n the two bodies are n . (c_l - c_k) - w_k(n) - w_l(n) apart at least
+  // (their support functions, half_width); along the centres' line this is never below the
+  // bounding balls' gap (w <= a_max), and it depends on the configuration alone (not on
+  // the pair's last GJK direction: the same radii whatever was asked before)
+  double gap = centres - a.a_max - b.a_max;
+  if (centres > 0.0) {
+    const coal::Vec3s n = between / centres;
+    gap = std::max(gap, centres - half_width(a, frames[k], n) - half_width(b, frames[l], n));
+  }
   // the gap's rounding is below 1e-12 of the numbers involved
-  return centres - a.a_max - b.a_max - 1e-12 * (1.0 + centres + a.a_max + b.a_max);
+  return gap - 1e-12 * (1.0 + centres + a.a_max + b.a_max);
 }
 
 double ArmWorld::group_gap(std::size_t g, const double* centres) const {

@@ -99,7 +99,8 @@ class ArmWorld {
     return scene_->grown_body_clear(k, frames[k], scale);
   }
   /// A certain lower bound of self pair m's distance with the bodies at `frames`: the
-  /// gap between their bounding balls, less rounding (<= 0: nothing known).
+  /// larger of the gap between their bounding balls and their separation along the
+  /// centres' line (support functions), less rounding (<= 0: nothing known).
   double pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;
   /// Self pair m's certain distance with the bodies at `frames` (coal's GJK, warm-started
   /// where the pair's last query ended, reduced by the allowance; 0 on contact).
