@@ -262,8 +262,13 @@ bool ArmCertifier::state_valid(const double* q) {
 }
 
 ArmGuard ArmCertifier::measure(const double* q, double enough) {
-  ++counters.guards;
   ArmGuard g;
+  measure_into(q, enough, g);
+  return g;
+}
+
+void ArmCertifier::measure_into(const double* q, double enough, ArmGuard& g) {
+  ++counters.guards;
   std::copy(q, q + n_, g.q.begin());
   const std::size_t bodies = chain_.bodies().size(), pairs = world_.pairs().size();
   g.scene.resize(bodies);
@@ -276,7 +281,7 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   g.grown.assign(bodies, 0);
   if (first_order_ || kc_ > 0.0) {
     g.joints = world_.joint_frames();
-    g.centres.reserve(3 * bodies);
+    g.centres.clear();
     for (const coal::Transform3s& f : frames)
       for (int i = 0; i < 3; ++i) g.centres.push_back(f.getTranslation()[i]);
     twist(g);
@@ -284,6 +289,7 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   const Chain& parts = world_.parts();
   g.part_levers.resize(parts.bodies().size() * n_);
   parts.levers(world_.joint_frames(), world_.part_frames(), g.part_levers.data());
+  g.part_centres.clear();
   for (const coal::Transform3s& f : world_.part_frames())
     for (int i = 0; i < 3; ++i) g.part_centres.push_back(f.getTranslation()[i]);
   if (enough > 0.0) {  // what a radius of `enough` needs: min(e v, e A + e^2 Q / 2, ...)
@@ -300,7 +306,7 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
   }
   g.clearance = std::numeric_limits<double>::infinity();
   for (double d : g.scene) g.clearance = std::min(g.clearance, d);
-  if (part_balls_ && enough > 0.0) return g;  // the pairs when a radius asks (pair_radius)
+  if (part_balls_ && enough > 0.0) return;  // the pairs when a radius asks (pair_radius)
   for (std::size_t m = 0; m < pairs; ++m) {
     g.pairs[m] = world_.pair_gap(m, frames);
     g.pair_known[m] = 1;
@@ -310,7 +316,6 @@ ArmGuard ArmCertifier::measure(const double* q, double enough) {
     }
     g.clearance = std::min(g.clearance, g.pairs[m]);
   }
-  return g;
 }
 
 double ArmCertifier::radius(const ArmGuard& guard, double enough) {
@@ -426,7 +431,8 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
       [&](double m, double s0, double s1, double& g_lo, double& g_hi) {
         for (int j = 0; j < n_; ++j) q_[j] = q1[j] + m * (q2[j] - q1[j]);
         const double enough = 0.5 * (s1 - s0);  // this guard covers [s0, s1] with that
-        const double r = radius(measure(q_.data(), enough), enough);
+        measure_into(q_.data(), enough, scratch_);  // a guard of this edge only: not kept
+        const double r = radius(scratch_, enough);
         if (r <= 0.0) return false;
         g_lo = m - r, g_hi = m + r;
         return true;

@@ -128,6 +128,8 @@ class ArmCertifier {
   /// edge, and never below kClearanceFloor, so that clearance > 0 still means free;
   /// otherwise wholly.
   ArmGuard measure(const double* q, double enough = -1.0);
+  /// measure() into `g`, reusing its storage.
+  void measure_into(const double* q, double enough, ArmGuard& g);
   /// The half width, in s, of a stretch `guard` proves free for the current edge (the
   /// class docs), or a radius of at least `enough` (the guard's bounds are refined where
   /// they would limit it below that).
@@ -223,6 +225,7 @@ class ArmCertifier {
   std::vector<double> group_first_, group_second_;  // groups x dof: joint carries one part only
   std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
   std::vector<std::pair<double, double>> pending_;
+  ArmGuard scratch_;  // the advancement's guards, measured in place
 };
 
 }  // namespace kcplan
