@@ -6,19 +6,23 @@ advancement) against :class:`World`, the scenario's obstacles as coal geometry i
 broad phase. Each C++ class has a Python twin that is the readable reference and is tested
 against it edge by edge:
 
-================================= ==========================================
-C++ (``kcplan/_kernel/``)          Python twin
-================================= ==========================================
-``pose.hpp`` ``Pose``, ``Edge``    :mod:`kcplan.geometry.pose`
-``robot.hpp`` ``Robot``            :mod:`kcplan.geometry.robot`
-``world.hpp`` ``World``            :class:`kcplan.world.CollisionWorld`
-``occupancy.hpp``                  :mod:`kcplan.world.occupancy`
-``guard.hpp``                      :mod:`kcplan.planning.guard`
-``certificates.hpp``               :mod:`kcplan.planning.certificates`
-``certifier.hpp`` ``EdgeCertifier`` :mod:`kcplan.planning.certifier`
-``mesh_planes.hpp`` ``MeshPlanes``   none: python-fcl measures meshes with
-                                  FCL's BVH; tested against it
-================================= ==========================================
+======================================= ======================================================
+C++ (``kcplan/_kernel/``)               Python twin
+======================================= ======================================================
+``pose.hpp`` ``Pose``, ``Edge``         :mod:`kcplan.geometry.pose`
+``robot.hpp`` ``Robot``                 :mod:`kcplan.geometry.robot`
+``world.hpp`` ``World``                 :class:`kcplan.world.CollisionWorld`
+``occupancy.hpp``                       :mod:`kcplan.world.occupancy`
+``guard.hpp``                           :mod:`kcplan.planning.guard`
+``certificates.hpp``                    :mod:`kcplan.planning.certificates`
+``certifier.hpp`` ``EdgeCertifier``     :mod:`kcplan.planning.certifier`
+``mesh_planes.hpp`` ``MeshPlanes``      none: python-fcl measures meshes with
+                                        FCL's BVH; tested against it
+``chain.hpp`` ``Chain``                 :mod:`kcplan.arm.kinematics`, :mod:`kcplan.arm.bounds`
+``arm_world.hpp`` ``ArmWorld``          :class:`kcplan.arm.ArmWorld`
+``pair_motion.hpp`` ``PairFirstOrder``  :func:`kcplan.arm.bounds.relative_first_order`
+``arm_certifier.hpp`` ``ArmCertifier``  :mod:`kcplan.planning.arm_certifier`
+======================================= ======================================================
 
 Conventions: poses are flat, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]`` (scalar
 last), lengths in the scenario's unit. Errors (a pose that is not finite given to a world
