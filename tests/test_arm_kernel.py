@@ -242,9 +242,10 @@ def test_kernel_certifier_decides_as_the_python_certifier(panda, world, states):
     assert k["certified_by_endpoints"] + k["certified_one_guard"] < k["edges"] - k["rejected"]
 
 
-def test_every_edge_the_kernel_accepts_is_free_on_the_meshes(panda, world, states):
+@pytest.mark.parametrize("kc_inflation", [0.0, 0.5])  # the balls; and the KC guards too
+def test_every_edge_the_kernel_accepts_is_free_on_the_meshes(panda, world, states, kc_inflation):
     free = [q for q in states if not world.in_collision(q)]
-    kernel = KernelArmCertifier(world)
+    kernel = KernelArmCertifier(world, kc_inflation=kc_inflation)
     rng = np.random.default_rng(5)
     accepted = 0
     for _ in range(60):
@@ -255,6 +256,7 @@ def test_every_edge_the_kernel_accepts_is_free_on_the_meshes(panda, world, state
             check = verify_arm_path(panda, world.obstacles, [q1, q2])
             assert not check.collides, (q1, q2, check)
     assert accepted >= 15
+    assert (kernel.counters["grown_queries"] > 0) == (kc_inflation > 0)
 
 
 def test_the_kernel_never_certifies_a_bad_state(panda, world, states):
