@@ -87,7 +87,8 @@ PLANNERS: dict[str, PlannerSpec] = {
         og.RRTConnect,
         _KC,
         description="stock RRT-Connect, edges certified by free-region planes (exact); "
-        "OMPL's default range (0.2 x the space's maximum extent)",
+        "OMPL's default range (0.2 x the space's maximum extent); arms: the chain's "
+        "clearance balls and the KC guards, range ARM_RANGE",
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
@@ -96,7 +97,7 @@ PLANNERS: dict[str, PlannerSpec] = {
         og.RRTConnect,
         _CA,
         description="ablation: kc-rrtconnect with the plain clearance ball only "
-        "(classic conservative advancement)",
+        "(classic conservative advancement; arms: without the KC guards)",
     ),
     "ca-prm": PlannerSpec(og.PRM, _CA, description="ablation: kc-prm with the clearance ball only"),
     "kc-rrtconnect-paper": PlannerSpec(
