@@ -75,8 +75,7 @@ double ArmCertifier::body_reach(const ArmGuard& guard, std::size_t k, double d) 
 
 void ArmCertifier::twist(const ArmGuard& guard) {
   chain_.twists(guard.joints, guard.centres.data(), step_.data(), w_, u_);
-  for (std::size_t k = 0; k < first_.size(); ++k)  // Chain::first_order_speeds
-    first_[k] = (u_[k].norm() + w_[k].norm() * chain_.bodies()[k].a_max) * (1.0 + 1e-12);
+  for (std::size_t k = 0; k < first_.size(); ++k) first_[k] = chain_.first_order_speed(k, w_[k], u_[k]);
 }
 
 template <class Frames>

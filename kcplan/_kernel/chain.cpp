@@ -207,7 +207,7 @@ void Chain::first_order_speeds(const std::vector<coal::Transform3s>& joints, con
   std::vector<coal::Vec3s> w, u;
   twists(joints, centres, dq, w, u);
   for (std::size_t k = 0; k < bodies_.size(); ++k)
-    out[k] = (u[k].norm() + w[k].norm() * bodies_[k].a_max) * (1.0 + 1e-12);  // and rounding
+    out[k] = first_order_speed(k, w[k], u[k]);
 }
 
 void Chain::turn_speeds(const double* dq, double* out) const {

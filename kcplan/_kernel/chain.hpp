@@ -94,6 +94,11 @@ class Chain {
   /// bodies' centres there (3 numbers per body).
   void first_order_speeds(const std::vector<coal::Transform3s>& joints, const double* centres,
                           const double* dq, double* out) const;
+  /// The fastest any point of body k moves with angular velocity w and centre velocity u:
+  /// |u| + |w| a_max,k, rounded up (one number of first_order_speeds).
+  double first_order_speed(std::size_t k, const coal::Vec3s& w, const coal::Vec3s& u) const {
+    return (u.norm() + w.norm() * bodies_[k].a_max) * (1.0 + 1e-12);  // and rounding
+  }
   /// The bodies' twists at one q along the signed joint step `dq` (kcplan/arm/bounds.py
   /// twists): w[k] the angular velocity of body k, u[k] the velocity of its centre, per
   /// unit of the edge parameter (world frame), from joint_frames and the bodies' centres

@@ -54,9 +54,8 @@ double PairFirstOrder::body_speed(int s, int k) {
   }
   const int i = chain_.bodies()[k].joint;
   const coal::Vec3s c(centres_[3 * k], centres_[3 * k + 1], centres_[3 * k + 2]);
-  // Chain::first_order_speeds of body k, with set s's joints still
-  speeds_[at] = ((w_[s][i].cross(c) + u_[s][i]).norm() +
-                 w_[s][i].norm() * chain_.bodies()[k].a_max) * (1.0 + 1e-12);
+  // body k's first order with set s's joints still
+  speeds_[at] = chain_.first_order_speed(k, w_[s][i], w_[s][i].cross(c) + u_[s][i]);
   speed_at_[at] = guard_;
   return speeds_[at];
 }

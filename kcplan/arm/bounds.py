@@ -109,6 +109,7 @@ __all__ = [
     "relative_speeds",
     "speeds",
     "turn_speeds",
+    "twist_speeds",
     "twists",
 ]
 
@@ -314,7 +315,13 @@ def first_order_speeds(arm: ArmModel, state: Sequence[float], dq: Sequence[float
     ``state`` along the joint step ``dq`` (signed, per unit of the edge parameter), from
     the body's exact twist there (:func:`twists`; module docstring, *First order*); shape
     ``(len(arm.bodies),)``, metres."""
-    w, u = twists(arm, state, dq)
+    return twist_speeds(arm, *twists(arm, state, dq))
+
+
+def twist_speeds(arm: ArmModel, w: NDArray, u: NDArray) -> NDArray[np.float64]:
+    """``|u_k| + |w_k| a_max,k`` of the bodies' twists ``(w, u)`` (:func:`twists`): what
+    :func:`first_order_speeds` gives, for twists already at hand; shape
+    ``(len(arm.bodies),)``."""
     a_max = np.array([body.semi_axes.max() for body in arm.bodies])
     return np.linalg.norm(u, axis=1) + np.linalg.norm(w, axis=1) * a_max
 

@@ -85,6 +85,7 @@ from kcplan.arm.bounds import (
     relative_first_order,
     relative_speeds,
     turn_speeds,
+    twist_speeds,
     twists,
 )
 from kcplan.arm.kinematics import body_frames
@@ -272,9 +273,7 @@ class ArmEdgeCertifier:
         if self.first_order or guard.grown is not None:
             w, velocity = twists(self.arm, guard.state, step)
             if self.first_order:
-                # kcplan.arm.bounds.first_order_speeds, from the twists already at hand
-                speeds = np.linalg.norm(velocity, axis=1) + np.linalg.norm(w, axis=1) * a.max(1)
-                twist = (speeds, accel)
+                twist = (twist_speeds(self.arm, w, velocity), accel)
         bodies = _reaches(guard.scene, speed, L @ dq, growth, twist)
         if guard.grown is not None:
             rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
