@@ -13,7 +13,7 @@ with the certificates of the ``kc-*`` planners (the clearance balls and the KC g
 inflation ``--kc-inflation``; 0: the balls alone, as ``ca-*``).
 
 Every **accepted** edge (of either backend) is re-checked by the gap-free mesh verifier
-(:func:`kcplan.arm.verify.verify_arm_path`: the links' own collision meshes, python-fcl,
+(:class:`kcplan.arm.verify.ArmMeshChecker`: the links' own collision meshes, python-fcl,
 independent of the covers and the certifiers); a *violation* is an accepted edge it finds
 in collision, and must be 0. A rejected edge is counted under the step that rejected it
 (the certifier's counters: an end state invalid or outside the limits, a colliding probe,
@@ -45,7 +45,7 @@ import numpy as np
 
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
-from kcplan.arm.verify import verify_arm_path
+from kcplan.arm.verify import ArmMeshChecker
 from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
 
@@ -112,6 +112,7 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
             problem = chosen[(k // per_problem) % len(chosen)]
             world = ArmWorld(arm, problem.obstacles, allowed=problem.allowed)
             kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation)
+            meshes = ArmMeshChecker(arm, problem.obstacles, problem.allowed)
             twin = None
             if k < args.twin:
                 twin = ArmEdgeCertifier(world, kc_inflation=args.kc_inflation)
@@ -124,7 +125,7 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
         for name in ("grown_queries", "kc_reaches"):  # what the KC guards did
             c[name] += kernel.counters[name] - before[name]
         verdict = None
-        verified = functools.partial(_collides, arm, problem, q1, q2, c)
+        verified = functools.partial(_collides, meshes, q1, q2, c)
         if ok:
             c["accepted"] += 1
             verdict = verified()
@@ -157,10 +158,10 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
     return {"counts": c, "steps": steps, "arm": arm, "problems": len(chosen)}
 
 
-def _collides(arm, problem, q1: np.ndarray, q2: np.ndarray, c: dict) -> bool:
+def _collides(meshes: ArmMeshChecker, q1: np.ndarray, q2: np.ndarray, c: dict) -> bool:
     """Whether the mesh verifier finds the edge ``q1 -> q2`` in collision (timed in ``c``)."""
     t = time.perf_counter()
-    hit = verify_arm_path(arm, problem.obstacles, [q1, q2], allowed=problem.allowed)
+    hit = meshes.check([q1, q2])
     c["verify_s"] += time.perf_counter() - t
     c["verified"] += 1
     return hit.collides

@@ -10,7 +10,7 @@ from ompl import base as ob
 from ompl import geometric as og
 
 from kcplan.arm import ArmWorld
-from kcplan.arm.verify import verify_arm_path
+from kcplan.arm.verify import ArmMeshChecker, verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
 from kcplan.planning.states import joint_space, set_joint_state
@@ -58,6 +58,35 @@ def test_accepted_arm_edges_are_free_on_the_meshes(panda, scene):
     assert c["edges"] == c["rejected"] + accepted
     reasons = ("rejected_end_state", "rejected_probe", "rejected_guard", "not_proven")
     assert sum(c[k] for k in reasons) == c["rejected"]
+
+
+def test_the_mesh_checker_misses_no_contact_that_dense_sampling_sees(panda, scene):
+    """Each link and self pair keeps its own horizon (ArmMeshChecker): on random edges a
+    contact found by 400 evenly spaced samples is found by the checker too, and where the
+    checker reports one the meshes are within its tolerance there."""
+    _, obstacles = scene
+    checker = ArmMeshChecker(panda, obstacles)
+    items = len(checker._links) + len(checker._pairs)
+    rng = np.random.default_rng(5)
+    found = 0
+    for scale in (1.0, 0.3, 0.1):
+        for _ in range(8):
+            q1 = rng.uniform(panda.lower, panda.upper)
+            q2 = np.clip(q1 + scale * rng.uniform(-3, 3, 7), panda.lower, panda.upper)
+            check = checker.check([q1, q2])
+            dense = False
+            for s in np.linspace(0.0, 1.0, 400):
+                checker._place(q1 + s * (q2 - q1))
+                if min(checker._distance(i) for i in range(items)) <= checker.tolerance:
+                    dense = True
+                    break
+            assert check.collides or not dense, (q1.tolist(), q2.tolist())
+            if check.collides:
+                found += 1
+                checker._place(q1 + check.where[1] * (q2 - q1))
+                assert min(checker._distance(i) for i in range(items)) <= checker.tolerance
+            assert check.collides or check.queries >= items  # each item measured once
+    assert found >= 5  # the scene is cluttered enough for the test to mean something
 
 
 def test_an_edge_that_meets_the_scene_midway_is_rejected(panda, scene):

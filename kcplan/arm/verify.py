@@ -6,12 +6,14 @@ geometry itself (python-fcl BVH meshes, or the primitives), placed by Pinocchio'
 every link ``g`` is ``D_g`` from the obstacles and ``D_gh`` from each link ``h`` it may
 collide with; its points move at most ``V_g`` per unit of ``s`` (the chain's bound of
 :func:`kcplan.arm.bounds.chain_speeds`, with the mesh's own farthest vertex as the reach),
-so the next sample is ``s + min(D_g / V_g, D_gh / V_gh)``: no stretch is skipped that
-could hide a contact. A distance at or below ``tolerance`` is a collision.
+so link ``g`` is measured against the scene again at ``s + D_g / V_g`` and against ``h`` at
+``s + D_gh / V_gh`` (:class:`ArmMeshChecker`): no stretch is skipped that could hide a
+contact. A distance at or below ``tolerance`` is a collision.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass
@@ -26,7 +28,7 @@ from kcplan.arm.model import ArmModel
 from kcplan.world.collision import fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
 
-__all__ = ["ArmPathCheck", "verify_arm_path"]
+__all__ = ["ArmMeshChecker", "ArmPathCheck", "verify_arm_path"]
 
 
 @dataclass(frozen=True)
@@ -41,13 +43,28 @@ class ArmPathCheck:
     where : tuple
         ``(segment, s)`` of the first contact, or ``()``.
     queries : int
-        Distance queries (one per sample).
+        Distance queries made (a link against the scene, or two links).
     """
 
     collides: bool
     min_clearance: float
     where: tuple = ()
     queries: int = 0
+
+
+@functools.lru_cache(maxsize=256)
+def _mesh(path: str, scale: tuple[float, float, float]) -> tuple[fcl.BVHModel, float]:
+    """A collision mesh file as an FCL BVH model (scaled), and its farthest vertex's
+    distance from the mesh's origin; loaded once per process (the model is shared by the
+    collision objects that place it)."""
+    mesh = trimesh.load(path, force="mesh", process=False)
+    V = np.asarray(mesh.vertices, dtype=float) * np.asarray(scale, dtype=float)
+    F = np.asarray(mesh.faces, dtype=np.int32)
+    model = fcl.BVHModel()
+    model.beginModel(len(V), len(F))
+    model.addSubModel(V, F)
+    model.endModel()
+    return model, float(np.linalg.norm(V, axis=1).max())
 
 
 def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
@@ -62,14 +79,127 @@ def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
     if kind == "Cylinder":
         r, c = float(shape.radius), float(shape.halfLength)
         return fcl.Cylinder(r, 2 * c), math.hypot(r, c)
-    mesh = trimesh.load(obj.meshPath, force="mesh", process=False)
-    V = np.asarray(mesh.vertices, dtype=float) * np.asarray(obj.meshScale, dtype=float)
-    F = np.asarray(mesh.faces, dtype=np.int32)
-    model = fcl.BVHModel()
-    model.beginModel(len(V), len(F))
-    model.addSubModel(V, F)
-    model.endModel()
-    return model, float(np.linalg.norm(V, axis=1).max())
+    return _mesh(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
+
+
+class ArmMeshChecker:
+    """The links' own collision meshes of an arm in a scene, built once to check many
+    paths (see the module docstring).
+
+    Parameters
+    ----------
+    arm : ArmModel
+    obstacles : sequence of Obstacle
+    allowed : collection of frozenset
+        Link pairs (names) never checked against each other (the scene's allowed
+        collision matrix), beside the SRDF's disabled pairs.
+    tolerance : float
+        A distance at or below this (metres) is a collision.
+
+    Notes
+    -----
+    Each link against the scene and each self pair is an *item* with its own horizon:
+    measured at ``s`` with distance ``D`` and speed bound ``V`` (per unit of the
+    segment's parameter, for the whole segment), it cannot touch anything before
+    ``s + D / V``. The check samples the smallest horizon and measures again only the
+    items whose horizon it has reached, so a pair of links far apart is measured once
+    per segment, not at every sample; each item's horizons still cover the whole
+    segment without gaps.
+    """
+
+    def __init__(
+        self,
+        arm: ArmModel,
+        obstacles: Sequence[Obstacle],
+        allowed: Collection[frozenset] = (),
+        tolerance: float = 1e-6,
+    ) -> None:
+        geometry = arm.geometry
+        self.arm, self.tolerance = arm, float(tolerance)
+        self._links, reaches, joints = [], [], []
+        for obj in geometry.geometryObjects:
+            shape, reach = _link_geometry(obj)
+            self._links.append(fcl.CollisionObject(shape, fcl.Transform()))
+            # the geometry's points lie within its placement's length plus its own reach
+            reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)
+            joints.append(int(obj.parentJoint))
+        link = [arm.model.frames[obj.parentFrame].name for obj in geometry.geometryObjects]
+        self._pairs = np.array(
+            [
+                (p.first, p.second)
+                for p in geometry.collisionPairs
+                if frozenset((link[p.first], link[p.second])) not in allowed
+            ],
+            dtype=int,
+        ).reshape(-1, 2)
+        self._rho = chain_speeds(arm, joints, reaches)
+        self._rho_pairs = relative_speeds(self._rho, carries(arm, joints), self._pairs)
+        scene = []
+        for ob in obstacles:
+            for shape, tf in fcl_obstacle_parts(ob, 3):
+                scene.append(fcl.CollisionObject(shape, tf))
+        self._scene = scene  # the manager keeps pointers to these objects
+        self._manager = fcl.DynamicAABBTreeCollisionManager()
+        if scene:
+            self._manager.registerObjects(scene)
+            self._manager.setup()
+        self._data, self._gdata = arm.model.createData(), geometry.createData()
+
+    def _place(self, q: np.ndarray) -> None:
+        import pinocchio as pin
+
+        geometry = self.arm.geometry
+        pin.forwardKinematics(self.arm.model, self._data, self.arm.configuration(q))
+        pin.updateGeometryPlacements(self.arm.model, self._data, geometry, self._gdata)
+        for obj, placement in zip(self._links, self._gdata.oMg, strict=True):
+            obj.setTransform(fcl.Transform(placement.rotation, placement.translation))
+
+    def _distance(self, item: int) -> float:
+        """Item ``item``'s distance as placed: link ``item`` against the scene, or self
+        pair ``item - links``."""
+        links = len(self._links)
+        if item < links:
+            if not self._scene:
+                return math.inf
+            result = fcl.DistanceData()
+            self._manager.distance(self._links[item], result, fcl.defaultDistanceCallback)
+            return float(result.result.min_distance)
+        a, b = self._pairs[item - links]
+        return float(
+            fcl.distance(self._links[a], self._links[b], fcl.DistanceRequest(), fcl.DistanceResult())
+        )
+
+    def check(self, states: Sequence[ArrayLike], max_queries: int = 1_000_000) -> ArmPathCheck:
+        """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints`
+        order) without gaps; ``max_queries`` distance queries per segment at most
+        (RuntimeError beyond)."""
+        queries, lowest = 0, math.inf
+        states = [np.asarray(q, dtype=float) for q in states]
+        for index, (q1, q2) in enumerate(zip(states[:-1], states[1:], strict=True)):
+            dq = np.abs(q2 - q1)
+            speeds = np.concatenate([self._rho @ dq, self._rho_pairs @ dq])
+            horizon = np.zeros(len(speeds))
+            budget = queries + max_queries
+            while horizon.size:
+                s = float(horizon.min())
+                if s > 1.0:
+                    break
+                self._place(q1 + s * (q2 - q1))
+                for item in np.flatnonzero(horizon <= s):
+                    d = self._distance(int(item))
+                    queries += 1
+                    lowest = min(lowest, d)
+                    if d <= self.tolerance:
+                        return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries)
+                    # free on [s, s + d / v): this item's next sample is there
+                    v = speeds[item]
+                    step = d / v if v > 0 else math.inf
+                    horizon[item] = s + max(step * (1.0 - 1e-6), 1e-9)
+                if queries >= budget:
+                    raise RuntimeError(
+                        f"verify: more than {max_queries} queries on segment {index}"
+                    )
+        return ArmPathCheck(False, lowest, (), queries)
 
 
 def verify_arm_path(
@@ -83,82 +213,5 @@ def verify_arm_path(
     """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints` order)
     without gaps against ``obstacles`` and self-collision (the pairs of
     :attr:`ArmModel.geometry` whose links are not an ``allowed`` pair); see the module
-    docstring."""
-    import pinocchio as pin
-
-    geometry = arm.geometry
-    links, reaches, joints = [], [], []
-    for obj in geometry.geometryObjects:
-        shape, reach = _link_geometry(obj)
-        links.append(fcl.CollisionObject(shape, fcl.Transform()))
-        # the geometry's points lie within its placement's length plus its own reach
-        reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)
-        joints.append(int(obj.parentJoint))
-    link = [arm.model.frames[obj.parentFrame].name for obj in geometry.geometryObjects]
-    pairs = np.array(
-        [
-            (p.first, p.second)
-            for p in geometry.collisionPairs
-            if frozenset((link[p.first], link[p.second])) not in allowed
-        ],
-        dtype=int,
-    ).reshape(-1, 2)
-    rho = chain_speeds(arm, joints, reaches)
-    rho_pairs = relative_speeds(rho, carries(arm, joints), pairs)
-    scene = []
-    for ob in obstacles:
-        for shape, tf in fcl_obstacle_parts(ob, 3):
-            scene.append(fcl.CollisionObject(shape, tf))
-    manager = fcl.DynamicAABBTreeCollisionManager()
-    if scene:
-        manager.registerObjects(scene)
-        manager.setup()
-    data, gdata = arm.model.createData(), geometry.createData()
-    request = fcl.DistanceRequest()
-
-    def distances(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        pin.forwardKinematics(arm.model, data, arm.configuration(q))
-        pin.updateGeometryPlacements(arm.model, data, geometry, gdata)
-        for obj, placement in zip(links, gdata.oMg, strict=True):
-            obj.setTransform(fcl.Transform(placement.rotation, placement.translation))
-        d_scene = np.full(len(links), math.inf)
-        if scene:
-            for g, obj in enumerate(links):
-                result = fcl.DistanceData()
-                manager.distance(obj, result, fcl.defaultDistanceCallback)
-                d_scene[g] = float(result.result.min_distance)
-        d_pairs = np.array(
-            [fcl.distance(links[a], links[b], request, fcl.DistanceResult()) for a, b in pairs]
-        )
-        return d_scene, d_pairs
-
-    queries, lowest = 0, math.inf
-    states = [np.asarray(q, dtype=float) for q in states]
-    for index, (q1, q2) in enumerate(zip(states[:-1], states[1:], strict=True)):
-        dq = np.abs(q2 - q1)
-        v_scene = rho @ dq
-        v_pairs = rho_pairs @ dq
-        s = 0.0
-        while True:
-            d_scene, d_pairs = distances(q1 + s * (q2 - q1))
-            queries += 1
-            lowest = min(
-                lowest, float(d_scene.min(initial=math.inf)), float(d_pairs.min(initial=math.inf))
-            )
-            if (d_scene <= tolerance).any() or (d_pairs <= tolerance).any():
-                return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries)
-            if s >= 1.0 or queries >= max_queries:
-                break
-            with np.errstate(divide="ignore"):
-                step = min(
-                    float(
-                        np.min(np.where(v_scene > 0, d_scene / v_scene, math.inf), initial=math.inf)
-                    ),
-                    float(
-                        np.min(np.where(v_pairs > 0, d_pairs / v_pairs, math.inf), initial=math.inf)
-                    ),
-                )
-            s = min(1.0, s + max(step * (1.0 - 1e-6), 1e-9))
-        if queries >= max_queries:
-            raise RuntimeError(f"verify: more than {max_queries} queries on segment {index}")
-    return ArmPathCheck(False, lowest, (), queries)
+    docstring. To check many paths in one scene, build an :class:`ArmMeshChecker` once."""
+    return ArmMeshChecker(arm, obstacles, allowed, tolerance).check(states, max_queries)
