@@ -166,7 +166,9 @@ class ArmMeshChecker:
             return float(result.result.min_distance)
         a, b = self._pairs[item - links]
         return float(
-            fcl.distance(self._links[a], self._links[b], fcl.DistanceRequest(), fcl.DistanceResult())
+            fcl.distance(
+                self._links[a], self._links[b], fcl.DistanceRequest(), fcl.DistanceResult()
+            )
         )
 
     def check(self, states: Sequence[ArrayLike], max_queries: int = 1_000_000) -> ArmPathCheck:
