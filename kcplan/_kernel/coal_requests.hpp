@@ -23,9 +23,20 @@ inline coal::DistanceRequest distance_request(bool nearest_points) {
 /// A yes/no collision request: no contact (so no EPA on an overlap), and GJK may stop as
 /// soon as it proves a pair apart (distance > 0) instead of converging on the distance,
 /// which coal's default (no bound) does.
+///
+/// Without EPA, coal 3.0.3 reports an overlap found by GJK ("Collision": GJK's distance
+/// below its tolerance, 1e-6) with GJK's last distance, and counts it as a contact only
+/// below `collision_distance_threshold` (default 1e-12): where GJK's simplex ends a hair
+/// off the origin (exactly aligned shapes; a ball of radius 0.25 at the origin deep in
+/// the box of half sides (0.25, 0.25, 0.5) at (0.1, -0.2, 0.05) ends at 4e-12) a deep
+/// overlap was reported free. The threshold is therefore GJK's own tolerance: an overlap
+/// is always a contact, and so is a pair within 1e-6 (a rejection, never a wrong "free";
+/// tests/test_primitive_bound.py keeps the case).
 inline coal::CollisionRequest collision_request() {
   coal::CollisionRequest request(coal::NO_REQUEST, 1);
   request.enable_contact = false;
+  request.collision_distance_threshold =
+      request.gjk_tolerance + Eigen::NumTraits<coal::CoalScalar>::dummy_precision();
   request.distance_upper_bound = 0.0;
   request.gjk_initial_guess = coal::GJKInitialGuess::CachedGuess;
   return request;

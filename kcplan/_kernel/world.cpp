@@ -102,16 +102,36 @@ struct Collect : coal::CollisionCallBackBase {
 
 /// The broad phase's candidates for one query shape, each tried with its pair's warm
 /// start; stops at the first obstacle that touches the shape.
+/// The query shape's support function, found once per query and only if asked.
+struct World::QuerySupport {
+  explicit QuerySupport(const coal::CollisionObject* q) : query(q) {}
+  const coal::CollisionObject* query;
+  ShapeSupport support;
+  int known = -1;  // -1 not looked at, 0 the shape has none, 1 `support` holds it
+  /// Primitive::separation of `obstacle` from the query shape (-inf: nothing known).
+  double gap(const World& world, const coal::CollisionObject& obstacle, bool& exact) {
+    if (known < 0) known = ShapeSupport::of(*query, support) ? 1 : 0;
+    exact = false;
+    return known ? world.primitive_gap(support, obstacle, exact)
+                 : -std::numeric_limits<double>::infinity();
+  }
+};
+
 struct World::CollideNear : coal::CollisionCallBackBase {
-  CollideNear(World* w, coal::CollisionObject* q, std::size_t s) : world(w), query(q), shape(s) {}
+  CollideNear(World* w, coal::CollisionObject* q, std::size_t s)
+      : world(w), query(q), shape(s), support(q) {}
   World* world;
   coal::CollisionObject* query;
   std::size_t shape;
+  QuerySupport support;
   bool hit = false;
   coal::CollisionRequest request = collision_request();
   coal::CollisionResult result;
   bool collide(coal::CollisionObject* o1, coal::CollisionObject* o2) override {
     coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
+    bool exact;
+    if (support.gap(*world, *obstacle, exact) > 0.0)
+      return false;  // separated from the box, ball or cylinder along one line
     if (const auto bound = world->plane_bound(*query, *obstacle, false);
         bound && bound->value > 0.0)
       return false;  // clear of every triangle's plane: clear of the mesh
@@ -130,10 +150,11 @@ struct World::CollideNear : coal::CollisionCallBackBase {
 struct World::DistanceNear : coal::DistanceCallBackBase {
   DistanceNear(World* w, coal::CollisionObject* q, std::size_t s,
                double cap = std::numeric_limits<double>::infinity())
-      : world(w), query(q), shape(s), best(cap) {}
+      : world(w), query(q), shape(s), support(q), best(cap) {}
   World* world;
   coal::CollisionObject* query;
   std::size_t shape;
+  QuerySupport support;
   double best;  // starts at the cap: the broad phase then prunes every box beyond it
   coal::DistanceRequest request = distance_request(false);
   coal::DistanceResult result;
@@ -142,8 +163,16 @@ struct World::DistanceNear : coal::DistanceCallBackBase {
     coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
     // the boxes' distance bounds the shapes' (each box holds its shape): past the cap,
     // or past the best so far, the obstacle cannot lower the answer
-    if (query->getAABB().distance(obstacle->getAABB()) < best)
-      best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
+    if (query->getAABB().distance(obstacle->getAABB()) < best) {
+      // a primitive's separation bounds the distance from below: at or past `best` the
+      // obstacle cannot lower the answer; for a ball it is the distance
+      bool exact;
+      const double gap = support.gap(*world, *obstacle, exact);
+      if (exact && gap > 0.0)
+        best = std::min(best, gap);
+      else if (gap < best)
+        best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
+    }
     dist = best;
     return best <= 0.0;
   }
@@ -206,13 +235,14 @@ World::World(const Robot& robot, double half_height, double rtol, double atol)
 }
 
 void World::add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
-                const coal::Transform3s& transform, Support support) {
+                const coal::Transform3s& transform, Support support, Primitive primitive) {
   if (finalized_)
     throw std::invalid_argument("world: obstacles must be added before the first query");
   auto object = std::make_unique<coal::CollisionObject>(geometry, transform);
   object->computeAABB();
   object->setUserData(reinterpret_cast<void*>(supports_.size()));
   supports_.push_back(std::move(support));
+  primitives_.push_back(primitive);
   planes_.emplace_back();
   objects_.push_back(std::move(object));
 }
@@ -262,15 +292,16 @@ void World::add_box(const std::array<double, 3>& centre, const std::array<double
     corners.push_back(x);
     support.points.insert(support.points.end(), {x[0], x[1], x[2]});
   }
+  const Primitive primitive = Primitive::box(vec(centre), R, vec(half));
   if (R.isIdentity(0.0)) {
     add(std::make_shared<coal::Box>(2 * half[0], 2 * half[1], 2 * half[2]),
         coal::Transform3s(coal::Matrix3s::Identity(), vec(centre)),
-        std::move(support));
+        std::move(support), primitive);
     return;
   }
   static const std::vector<int> faces = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
                                          2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
-  add(convex(corners, faces), coal::Transform3s::Identity(), std::move(support));
+  add(convex(corners, faces), coal::Transform3s::Identity(), std::move(support), primitive);
 }
 
 void World::add_convex(const std::vector<double>& vertices, const std::vector<int>& triangles) {
@@ -290,7 +321,7 @@ void World::add_sphere(const std::array<double, 3>& centre, double radius) {
   support.radius = radius;
   add(std::make_shared<coal::Sphere>(radius),
       coal::Transform3s(coal::Matrix3s::Identity(), vec(centre)),
-      std::move(support));
+      std::move(support), Primitive::ball(vec(centre), radius));
 }
 
 void World::add_ellipsoid(const std::array<double, 3>& centre,
@@ -321,7 +352,8 @@ void World::add_cylinder(const std::array<double, 3>& centre,
   const double sizes[2] = {radius, half_height};
   require_positive(sizes, 2, "cylinder: expected a positive finite radius and height");
   add(std::make_shared<coal::Cylinder>(radius, 2.0 * half_height),
-      coal::Transform3s(matrix(rotation), vec(centre)), Support{});
+      coal::Transform3s(matrix(rotation), vec(centre)), Support{},
+      Primitive::cylinder(vec(centre), matrix(rotation), radius, half_height));
 }
 
 void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles) {
@@ -588,6 +620,20 @@ bool World::body_collides(std::size_t k) {
   return collides(*bodies_[k], k);
 }
 
+coal::CollisionObject& World::place_ball(const std::array<double, 3>& centre, double radius) {
+  if (!ball_) {
+    ball_shape_ = std::make_shared<coal::Sphere>(radius);
+    ball_ = std::make_unique<coal::CollisionObject>(ball_shape_);
+  }
+  if (ball_shape_->radius != radius) {
+    ball_shape_->radius = radius;
+    ball_shape_->computeLocalAABB();
+  }
+  ball_->setTransform(coal::Matrix3s::Identity(), Vec3s(centre[0], centre[1], centre[2]));
+  ball_->computeAABB();
+  return *ball_;
+}
+
 bool World::ball_collides(const std::array<double, 3>& centre, double radius) {
   ++counters.collision_queries;
   return ball_touches(centre, radius);
@@ -598,11 +644,7 @@ bool World::ball_touches(const std::array<double, 3>& centre, double radius) {
   if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
   if (!finalized_) finalize();
   if (objects_.empty()) return false;
-  coal::CollisionObject ball(std::make_shared<coal::Sphere>(radius),
-                             coal::Transform3s(coal::Matrix3s::Identity(),
-                                               Vec3s(centre[0], centre[1], centre[2])));
-  ball.computeAABB();
-  return collides(ball, core_shape());
+  return collides(place_ball(centre, radius), core_shape());
 }
 
 double World::ball_safe_clearance(const std::array<double, 3>& centre, double radius,
@@ -611,10 +653,7 @@ double World::ball_safe_clearance(const std::array<double, 3>& centre, double ra
   if (!(radius > 0.0)) throw std::invalid_argument("radius: expected a positive number");
   if (!finalized_) finalize();
   if (objects_.empty()) return std::numeric_limits<double>::infinity();
-  coal::CollisionObject ball(std::make_shared<coal::Sphere>(radius),
-                             coal::Transform3s(coal::Matrix3s::Identity(),
-                                               Vec3s(centre[0], centre[1], centre[2])));
-  ball.computeAABB();
+  coal::CollisionObject& ball = place_ball(centre, radius);
   // as capped_clearance: a raw distance of at least (cap + atol) / (1 - rtol) is certainly
   // at least cap
   const double raw = cap < std::numeric_limits<double>::infinity()

@@ -12,9 +12,11 @@
 #include <coal/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <coal/collision_data.h>
 #include <coal/collision_object.h>
+#include <coal/shape/geometric_shapes.h>
 
 #include "mesh_planes.hpp"
 #include "pose.hpp"
+#include "primitive_bound.hpp"
 #include "robot.hpp"
 
 namespace kcplan {
@@ -68,6 +70,10 @@ struct WorldCounters {
 /// never overestimates (the allowance is justified in kcplan/_kernel/__init__.py).
 /// Not thread-safe: the robot's coal objects, the solvers and GJK's warm starts are reused
 /// between queries.
+///
+/// A box, ball or cylinder obstacle keeps its parameters (Primitive): a robot shape
+/// whose separation from it along the line to its nearest point already decides a query
+/// (clear of it, or farther than the cap or the nearest so far) is not given to GJK.
 ///
 /// Every narrow-phase query of a (robot shape, obstacle) pair starts GJK where the pair's
 /// last query ended (its last direction and support vertices): for nearby poses GJK then
@@ -193,11 +199,12 @@ class World {
       hint = result.cached_support_func_guess;
     }
   };
+  struct QuerySupport;
   struct CollideNear;
   struct DistanceNear;
 
   void add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
-           const coal::Transform3s& transform, Support support);
+           const coal::Transform3s& transform, Support support, Primitive primitive = {});
   void place(const Pose& pose);
   /// `shape` is the row of warm starts: a body's index, or core_shape() for a ball or capsule.
   bool collides(coal::CollisionObject& object, std::size_t shape);
@@ -214,7 +221,16 @@ class World {
   std::optional<MeshPlanes::Bound> plane_bound(const coal::CollisionObject& query,
                                                const coal::CollisionObject& obstacle,
                                                bool measure) const;
+  /// Primitive::separation of `obstacle` from the query shape `shape` (<= 0 or -inf:
+  /// nothing known; `exact`: the bound is the distance).
+  double primitive_gap(const ShapeSupport& shape, const coal::CollisionObject& obstacle,
+                       bool& exact) const {
+    return primitives_[reinterpret_cast<std::size_t>(obstacle.getUserData())].separation(
+        shape, exact);
+  }
   std::size_t core_shape() const { return bodies_.size(); }
+  /// The one ball of ball queries, resized and moved to `centre` (not allocated anew).
+  coal::CollisionObject& place_ball(const std::array<double, 3>& centre, double radius);
   void count_body(std::size_t k);
 
   Robot robot_;
@@ -222,10 +238,13 @@ class World {
   double half_height_, rtol_, atol_;
   std::vector<std::unique_ptr<coal::CollisionObject>> objects_;
   std::vector<Support> supports_;
+  std::vector<Primitive> primitives_;  // per obstacle; kNone: not a box, ball or cylinder
   std::vector<std::unique_ptr<const MeshPlanes>> planes_;  // per obstacle; null: not a mesh
   std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
   std::vector<std::unique_ptr<coal::CollisionObject>> grown_;  // per body, made on first use
   std::vector<std::unique_ptr<coal::CollisionObject>> horizon_boxes_;
+  std::shared_ptr<coal::Sphere> ball_shape_;  // ball queries' shape and object (place_ball)
+  std::unique_ptr<coal::CollisionObject> ball_;
   std::vector<double> horizon_sides_;
   std::unique_ptr<coal::DynamicAABBTreeCollisionManager> manager_;
   std::vector<coal::CollisionObject*> near_;
