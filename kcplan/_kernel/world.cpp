@@ -100,8 +100,6 @@ struct Collect : coal::CollisionCallBackBase {
 
 }  // namespace
 
-/// The broad phase's candidates for one query shape, each tried with its pair's warm
-/// start; stops at the first obstacle that touches the shape.
 /// The query shape's support function, found once per query and only if asked.
 struct World::QuerySupport {
   explicit QuerySupport(const coal::CollisionObject* q) : query(q) {}
@@ -117,6 +115,8 @@ struct World::QuerySupport {
   }
 };
 
+/// The broad phase's candidates for one query shape, each tried with its pair's warm
+/// start; stops at the first obstacle that touches the shape.
 struct World::CollideNear : coal::CollisionCallBackBase {
   CollideNear(World* w, coal::CollisionObject* q, std::size_t s)
       : world(w), query(q), shape(s), support(q) {}
