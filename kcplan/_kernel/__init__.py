@@ -18,6 +18,8 @@ C++ (``kcplan/_kernel/``)               Python twin
 ``certifier.hpp`` ``EdgeCertifier``     :mod:`kcplan.planning.certifier`
 ``mesh_planes.hpp`` ``MeshPlanes``      none: python-fcl measures meshes with
                                         FCL's BVH; tested against it
+``primitive_bound.hpp`` ``Primitive``   none: a shortcut before GJK for boxes, balls
+                                        and cylinders; tested against exact distances
 ``chain.hpp`` ``Chain``                 :mod:`kcplan.arm.kinematics`, :mod:`kcplan.arm.bounds`
 ``arm_world.hpp`` ``ArmWorld``          :class:`kcplan.arm.ArmWorld`
 ``pair_motion.hpp`` ``PairFirstOrder``  :func:`kcplan.arm.bounds.relative_first_order`
