@@ -353,7 +353,9 @@ def plan(
         Seeds OMPL's RNG (first call per process only, see :func:`seed_ompl`).
     simplify : bool
         Shortcut and smooth the path with OMPL's simplifier; every new edge it makes is
-        checked by the same motion validator, so kc planners keep their guarantee.
+        checked by the same motion validator, so kc planners keep their guarantee. A
+        simplified path that fails the validator's final check (OMPL then only warns) is
+        dropped for the path ``solve()`` returned.
     world : CollisionWorld, optional
         Reuse a collision world (its counters are reset).
     first_solution : bool
@@ -434,17 +436,25 @@ def plan(
         solved = bool(ss.haveExactSolutionPath())
         simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
         if solved:
-            raw_length = float(ss.getSolutionPath().length())
+            path = ss.getSolutionPath()
+            raw_length = float(path.length())
+            states = [setup.read(s).tolist() for s in path.getStates()]
+            length = raw_length
+            del path
             if simplify:
                 t0 = time.perf_counter()
                 ss.simplifySolution(float(time_limit))
                 if validator is not None:
                     validator.raise_error()
+                path = ss.getSolutionPath()
+                # OMPL's simplifier returns a path whose last check and repair failed with
+                # only a warning ("may slightly touch on an invalid region"): keep the
+                # simplified path only when every state and edge of it passes the checker
+                if path.check():
+                    states = [setup.read(s).tolist() for s in path.getStates()]
+                    length = float(path.length())
+                del path
                 simplify_time = time.perf_counter() - t0
-            path = ss.getSolutionPath()
-            states = [setup.read(s).tolist() for s in path.getStates()]
-            length = float(path.length())
-            del path
         queries = setup.world.counters
         counters = {
             **queries,
