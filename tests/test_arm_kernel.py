@@ -200,8 +200,6 @@ def test_both_clearances_are_lower_bounds_of_the_sampled_distance(panda, world, 
         np.testing.assert_allclose(k_scene, p_scene, atol=0.02)
 
 
-
-
 def test_fcl_overestimates_thin_ellipsoids_and_the_arm_world_does_not():
     """The case that made the Python world take only FCL's direction: FCL's distance
     exceeds the sampled distance (an upper bound of the true one) by 7 %, and
