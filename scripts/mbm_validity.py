@@ -124,8 +124,8 @@ def print_offsets(arms: list) -> None:
     print(f"\n| link | {' | '.join(heads)} |")
     print(f"|---|{'---|' * len(arms)}")
     for obj in arms[0][3].geometry.geometryObjects:
-        if not obj.meshPath:
-            continue
+        if not obj.meshPath or type(obj.geometry).__name__ in ("Box", "Cylinder", "Sphere"):
+            continue  # a primitive: covered exactly, not fitted
         cells = []
         for _, bodies, max_offset, _ in arms:
             cover, _ = mesh_cover(obj.meshPath, bodies, float(obj.meshScale[0]), max_offset)

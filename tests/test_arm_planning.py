@@ -89,6 +89,31 @@ def test_the_mesh_checker_misses_no_contact_that_dense_sampling_sees(panda, scen
     assert found >= 5  # the scene is cluttered enough for the test to mean something
 
 
+def test_the_mesh_checker_measures_far_links_by_their_hulls_from_below(panda, scene, monkeypatch):
+    """A link's convex hull holds its mesh: where the hull is far, its distance (less the
+    margin) is a lower bound of the mesh's; near, the meshes themselves are measured."""
+    import kcplan.arm.verify as verify
+
+    _, obstacles = scene
+    checker = ArmMeshChecker(panda, obstacles)
+    items = range(len(checker._links) + len(checker._pairs))
+    rng = np.random.default_rng(11)
+    by_hull = 0
+    for _ in range(12):
+        checker._place(rng.uniform(panda.lower, panda.upper))
+        fast = [checker._distance(i) for i in items]
+        monkeypatch.setattr(verify, "HULL_NEAR", math.inf)
+        exact = [checker._distance(i) for i in items]
+        monkeypatch.undo()
+        for d, e in zip(fast, exact, strict=True):
+            assert d <= e + 1e-12
+            if d <= verify.HULL_NEAR:
+                assert d == e  # near: the meshes' own distance
+            else:
+                by_hull += d < e - 1e-9
+    assert by_hull > 50  # the hulls do serve
+
+
 def test_an_edge_that_meets_the_scene_midway_is_rejected(panda, scene):
     """Both ends free (covers and meshes), the meshes in contact near s = 0.59."""
     world, obstacles = scene

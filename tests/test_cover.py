@@ -10,6 +10,7 @@ import json
 import math
 import os
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,7 @@ from kcplan.cover import (
     read_solid,
     union_volume,
 )
+from kcplan.cover.bodies import body_holds, body_rotation
 from kcplan.cover.cache import cache_folder, cached_cover
 from kcplan.cover.partition import Piece, clip_simplices
 from kcplan.cover.profiles import PROFILES
@@ -39,6 +41,7 @@ from kcplan.geometry.enclosing import (
     mahalanobis_sq,
     minimum_volume_ellipsoid,
 )
+from kcplan.geometry.robot import Body
 from kcplan.geometry.winding import winding_numbers
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -387,6 +390,80 @@ def test_unreadable_parts_are_one_line_errors(tmp_path, capsys, name, data, mess
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err and str(path) in err
     assert not (tmp_path / "r.yaml").exists()
+
+
+def _soup(mesh: trimesh.Trimesh, jitter: float, seed: int = 0) -> trimesh.Trimesh:
+    """The mesh as a triangle soup (each triangle its own corners, as an STL), each corner
+    moved by ``jitter`` in a random direction: closed only up to ``jitter``."""
+    corners = mesh.vertices[mesh.faces].reshape(-1, 3)
+    u = np.random.default_rng(seed).normal(size=corners.shape)
+    corners = corners + jitter * u / np.linalg.norm(u, axis=1, keepdims=True)
+    return trimesh.Trimesh(corners, np.arange(len(corners)).reshape(-1, 3), process=False)
+
+
+def _soup_box(jitter: float) -> trimesh.Trimesh:
+    return _soup(trimesh.creation.box((1, 2, 3)), jitter)
+
+
+def test_a_mesh_open_only_by_rounding_is_welded_and_its_cover_grown_by_the_weld(tmp_path):
+    from kcplan.cover.solid import WELD_TOLERANCE
+
+    jitter = 0.3 * WELD_TOLERANCE * 3.0  # the box's size is 3: copies 0.6 tolerances apart
+    soup = _soup_box(jitter)
+    soup.export(tmp_path / "soup.obj", digits=17)  # every digit of the corners
+    solid = read_solid(tmp_path / "soup.obj")
+    assert not solid.hull and len(solid.vertices) == 8
+    assert 0.5 * jitter < solid.weld <= 2 * jitter and math.isclose(solid.volume, 6.0)
+    cover = fit_cover(solid, bodies=2)
+    assert inside_union(soup.vertices, cover.bodies).all()  # the file's corners, each copy
+    bare = fit_cover(replace(solid, weld=0.0), bodies=2)
+    for grown, body in zip(cover.bodies, bare.bodies, strict=True):
+        grow = 1.0 + solid.weld / body.semi_axes.min()
+        assert np.allclose(grown.semi_axes, body.semi_axes * grow, rtol=1e-11, atol=0)
+        assert (grown.semi_axes - body.semi_axes >= solid.weld).all()
+    offset = fit_cover(solid, max_offset=0.5)
+    assert inside_union(soup.vertices, offset.bodies).all()
+    assert offset.offset >= fit_cover(replace(solid, weld=0.0), max_offset=0.5).offset + solid.weld
+    # copies farther apart than the tolerance are not welded: the soup stays open
+    _soup_box(3 * WELD_TOLERANCE * 3.0).export(tmp_path / "far.obj", digits=17)
+    with pytest.raises(SolidError, match="closed .watertight. mesh"):
+        read_solid(tmp_path / "far.obj")
+
+
+def test_a_weld_that_would_collapse_a_triangle_is_refused(tmp_path):
+    from kcplan.cover.solid import WELD_TOLERANCE
+
+    box = trimesh.creation.box((1, 2, 3))
+    V, F = box.vertices.copy(), box.faces.copy()
+    # a sliver: split face 0 by a corner within the tolerance of its first corner
+    near = V[F[0, 0]] + 0.1 * WELD_TOLERANCE * (V[F[0, 1]] - V[F[0, 0]])
+    V = np.vstack([V, near])
+    a, b, c = F[0]
+    F = np.vstack([F[1:], [[a, b, 8], [b, c, 8], [c, a, 8]]])
+    closed = trimesh.Trimesh(V, F, process=False)
+    assert closed.is_watertight
+    _soup(closed, 0.01 * WELD_TOLERANCE).export(tmp_path / "sliver.obj", digits=17)
+    with pytest.raises(SolidError, match="closed .watertight. mesh"):
+        read_solid(tmp_path / "sliver.obj")
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.floats(0.01, 2.0), min_size=3, max_size=3),
+    st.floats(1e-6, 0.5),
+    st.integers(0, 2**31),
+)
+def test_growing_semi_axes_by_w_covers_every_point_within_w(axes, w, seed):
+    """The lemma of ``kcplan.cover.fit._sound_body``'s weld growth, on sampled points."""
+    rng = np.random.default_rng(seed)
+    a = np.array(axes)
+    q = rng.normal(size=4)
+    body = Body(a, np.concatenate([[0.1, -0.2, 0.3], q / np.linalg.norm(q)]))
+    u = rng.normal(size=(400, 3))
+    surface = (u / np.linalg.norm(u, axis=1, keepdims=True)) * a @ body_rotation(body).T
+    v = rng.normal(size=(400, 3))
+    near = surface + body.position + w * v / np.linalg.norm(v, axis=1, keepdims=True)
+    assert body_holds(Body(a * (1.0 + w / a.min()) * (1.0 + 1e-12), body.pose), near) <= 1.0
 
 
 def test_open_and_flat_meshes_are_refused_and_hull_is_the_fallback(tmp_path, capsys):

@@ -8,7 +8,10 @@ collide with; its points move at most ``V_g`` per unit of ``s`` (the chain's bou
 :func:`kcplan.arm.bounds.chain_speeds`, with the mesh's own farthest vertex as the reach),
 so link ``g`` is measured against the scene again at ``s + D_g / V_g`` and against ``h`` at
 ``s + D_gh / V_gh`` (:class:`ArmMeshChecker`): no stretch is skipped that could hide a
-contact. A distance at or below ``tolerance`` is a collision.
+contact. A distance at or below ``tolerance`` is a collision. Where a link's convex hull
+(qhull's, of the mesh file's vertices) is farther than :data:`HULL_NEAR`, the hull's
+distance serves as ``D``: a lower bound, since the hull holds the mesh, and one query of a
+few hundred vertices instead of a BVH of tens of thousands of triangles.
 """
 
 from __future__ import annotations
@@ -29,6 +32,12 @@ from kcplan.world.collision import fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
 
 __all__ = ["ArmMeshChecker", "ArmPathCheck", "verify_arm_path"]
+
+HULL_NEAR = 0.02
+"""Metres: a link whose convex hull is farther than this from what it is measured against
+is measured by its hull (a lower bound of its mesh's distance), nearer by its mesh."""
+HULL_MARGIN = 1e-5
+"""Metres taken off a hull's distance: well above FCL's GJK tolerance (1e-6)."""
 
 
 @dataclass(frozen=True)
@@ -65,6 +74,20 @@ def _mesh(path: str, scale: tuple[float, float, float]) -> tuple[fcl.BVHModel, f
     model.addSubModel(V, F)
     model.endModel()
     return model, float(np.linalg.norm(V, axis=1).max())
+
+
+@functools.lru_cache(maxsize=256)
+def _hull(path: str, scale: tuple[float, float, float]) -> fcl.Convex | None:
+    """The convex hull of a collision mesh file (scaled) as an FCL solid, ``None`` when
+    qhull cannot build one (a flat mesh)."""
+    mesh = trimesh.load(path, force="mesh", process=False)
+    V = np.asarray(mesh.vertices, dtype=float) * np.asarray(scale, dtype=float)
+    try:
+        hull = trimesh.convex.convex_hull(V)
+    except Exception:  # qhull's errors on flat input are of several kinds
+        return None
+    faces = np.hstack([np.full((len(hull.faces), 1), 3), hull.faces]).astype(np.int32).ravel()
+    return fcl.Convex(np.asarray(hull.vertices, dtype=float), len(hull.faces), faces)
 
 
 def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
@@ -116,10 +139,16 @@ class ArmMeshChecker:
     ) -> None:
         geometry = arm.geometry
         self.arm, self.tolerance = arm, float(tolerance)
-        self._links, reaches, joints = [], [], []
+        self._links, self._hulls, reaches, joints = [], [], [], []
         for obj in geometry.geometryObjects:
             shape, reach = _link_geometry(obj)
             self._links.append(fcl.CollisionObject(shape, fcl.Transform()))
+            hull = (
+                _hull(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
+                if (isinstance(shape, fcl.BVHModel))
+                else None
+            )
+            self._hulls.append(None if hull is None else fcl.CollisionObject(hull, fcl.Transform()))
             # the geometry's points lie within its placement's length plus its own reach
             reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)
             joints.append(int(obj.parentJoint))
@@ -151,25 +180,40 @@ class ArmMeshChecker:
         geometry = self.arm.geometry
         pin.forwardKinematics(self.arm.model, self._data, self.arm.configuration(q))
         pin.updateGeometryPlacements(self.arm.model, self._data, geometry, self._gdata)
-        for obj, placement in zip(self._links, self._gdata.oMg, strict=True):
-            obj.setTransform(fcl.Transform(placement.rotation, placement.translation))
+        for obj, hull, placement in zip(self._links, self._hulls, self._gdata.oMg, strict=True):
+            tf = fcl.Transform(placement.rotation, placement.translation)
+            obj.setTransform(tf)
+            if hull is not None:
+                hull.setTransform(tf)
 
     def _distance(self, item: int) -> float:
-        """Item ``item``'s distance as placed: link ``item`` against the scene, or self
-        pair ``item - links``."""
+        """A lower bound of item ``item``'s distance as placed (link ``item`` against the
+        scene, or self pair ``item - links``), exact below :data:`HULL_NEAR`: the links'
+        convex hulls are asked first, and their distance, less :data:`HULL_MARGIN`, is
+        taken when it exceeds ``HULL_NEAR`` (a hull holds its mesh, so nothing is nearer
+        to the mesh than to its hull); the meshes themselves only otherwise."""
         links = len(self._links)
         if item < links:
             if not self._scene:
                 return math.inf
-            result = fcl.DistanceData()
-            self._manager.distance(self._links[item], result, fcl.defaultDistanceCallback)
-            return float(result.result.min_distance)
+            hull = self._hulls[item]
+            if hull is not None:
+                near = self._scene_distance(hull) - HULL_MARGIN
+                if near > HULL_NEAR:
+                    return near
+            return self._scene_distance(self._links[item])
         a, b = self._pairs[item - links]
-        return float(
-            fcl.distance(
-                self._links[a], self._links[b], fcl.DistanceRequest(), fcl.DistanceResult()
-            )
-        )
+        if self._hulls[a] is not None or self._hulls[b] is not None:
+            hull_a, hull_b = self._hulls[a] or self._links[a], self._hulls[b] or self._links[b]
+            near = _distance(hull_a, hull_b) - HULL_MARGIN
+            if near > HULL_NEAR:
+                return near
+        return _distance(self._links[a], self._links[b])
+
+    def _scene_distance(self, obj: fcl.CollisionObject) -> float:
+        result = fcl.DistanceData()
+        self._manager.distance(obj, result, fcl.defaultDistanceCallback)
+        return float(result.result.min_distance)
 
     def check(self, states: Sequence[ArrayLike], max_queries: int = 1_000_000) -> ArmPathCheck:
         """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints`
@@ -202,6 +246,10 @@ class ArmMeshChecker:
                         f"verify: more than {max_queries} queries on segment {index}"
                     )
         return ArmPathCheck(False, lowest, (), queries)
+
+
+def _distance(a: fcl.CollisionObject, b: fcl.CollisionObject) -> float:
+    return float(fcl.distance(a, b, fcl.DistanceRequest(), fcl.DistanceResult()))
 
 
 def verify_arm_path(

@@ -550,7 +550,7 @@ def fit_cover(
     out = []
     for k, leaf in enumerate(growth.leaves):
         leaf.node["body"] = k
-        out.append(_sound_body(leaf, shape))
+        out.append(_sound_body(leaf, shape, solid.weld))
     worst = max(
         body_holds(body, leaf.points) for body, leaf in zip(out, growth.leaves, strict=True)
     )
@@ -628,7 +628,7 @@ def _fit_offset(
     while True:
         for leaf in leaves:
             if id(leaf) not in bounds:
-                body = _sound_body(leaf, shape)
+                body = _sound_body(leaf, shape, solid.weld)
                 bounds[id(leaf)] = (body, meter.bound(body, tol, below=max_offset))
         over = [k for k, leaf in enumerate(leaves) if bounds[id(leaf)][1].high > max_offset]
         if not over:
@@ -659,7 +659,8 @@ def _fit_offset(
         leaf.node["body"] = k
         out.append(bounds[id(leaf)][0])
     worst = max(body_holds(body, leaf.points) for body, leaf in zip(out, leaves, strict=True))
-    offset_high = max(bounds[id(leaf)][1].high for leaf in leaves)
+    # measured from the welded solid; the file's triangles are within solid.weld of it
+    offset_high = max(bounds[id(leaf)][1].high for leaf in leaves) + solid.weld
     seconds = time.perf_counter() - start
     return Cover(solid, tuple(out), search.root.node, shape, seconds, note, worst, offset_high)
 
@@ -674,7 +675,7 @@ def _offset_cut(search: _Search, meter, leaf: _Leaf, shape: str) -> tuple[NDArra
     longest axis through the middle of the piece (a k-d tree's cut, which always makes the
     pieces smaller: a box-like piece needs two cuts before its offset drops, and the
     greedy choice alone then slices it into slabs that all stick out as far)."""
-    own, n = meter.witness(_sound_body(leaf, shape), OFFSET_SAMPLES)
+    own, n = meter.witness(_sound_body(leaf, shape, search.solid.weld), OFFSET_SAMPLES)
     V = leaf.piece.boundary_points
     axes = _directions(leaf.M)
     planes = [
@@ -741,13 +742,23 @@ def _best_sectors(
     return best
 
 
-def _sound_body(leaf: _Leaf, shape: str) -> Body:
+def _sound_body(leaf: _Leaf, shape: str, weld: float) -> Body:
     """The leaf's ellipsoid as a body, grown until it holds every hull point of its piece
-    as computed from the stored semi-axes and pose."""
+    as computed from the stored semi-axes and pose, then by ``weld`` (``Solid.weld``).
+
+    Scaling the semi-axes by ``s = 1 + w / a_min`` covers every point within ``w`` of the
+    body: for a unit ``u`` in the body's frame the scaled body's support function is
+    ``s |diag(a) u| >= |diag(a) u| + (w / a_min) a_min``, the support function of the body
+    swept by a ball of radius ``w``. (Adding ``w`` to each semi-axis would not do:
+    ``|diag(a + w) u| <= |diag(a) u| + w``, equal only along an axis.)
+    """
     body = body_from_ellipsoid(leaf.center, leaf.M, sphere=shape == "sphere")
     for _ in range(8):
         worst = body_holds(body, leaf.points)
         if worst < 1.0:
+            if weld > 0.0:
+                grow = 1.0 + weld / body.semi_axes.min()
+                body = Body(body.semi_axes * (grow * (1.0 + 1e-12)), body.pose)
             return body
         body = Body(body.semi_axes * np.sqrt(worst) * (1.0 + 1e-9), body.pose)
     raise RuntimeError("a body could not be made to hold its piece")  # pragma: no cover

@@ -4,7 +4,11 @@ Meshes are read with trimesh (STL, OBJ, PLY, OFF, glTF/GLB; a scene's meshes are
 outlines from YAML (a list of ``[x, y]``, or ``{vertices: [...]}``) or CSV (``x,y`` rows,
 a header line allowed). The solid is the input's own geometry: vertices are merged only
 where they are bit-for-bit equal (trimesh's default processing merges within ``1e-8``,
-which moves the surface), and faces are only reoriented, never moved.
+which moves the surface), and faces are only reoriented, never moved. One exception: a
+mesh that is open only because some of its corners differ by rounding (exported CAD
+parts, whose coordinates near 0 read as ``-1e-17`` in one triangle and ``3e-18`` in the
+next) is welded within :data:`WELD_TOLERANCE` of its size; ``Solid.weld`` is how far a
+corner moved, and a cover of the welded solid is grown by it (:func:`kcplan.cover.fit_cover`).
 
 Errors are :class:`SolidError` with one line naming the file and what was expected.
 """
@@ -31,6 +35,8 @@ OUTLINE_SUFFIXES = (".yaml", ".yml", ".csv")
 MAX_SOLID_BYTES = 256 * 2**20
 """Largest input file read, in bytes."""
 MAX_OUTLINE_VERTICES = 10_000
+WELD_TOLERANCE = 1e-9
+"""Corners of an open mesh closer than this times the mesh's size are welded into one."""
 
 
 class SolidError(ValueError):
@@ -59,6 +65,10 @@ class Solid:
         cache's key; a glTF's buffers may live in other files).
     hull : bool
         True when the part is the convex hull of the file's mesh (``--hull``).
+    weld : float
+        The largest distance a corner of the file's mesh moved when near corners were
+        welded (0 when none were): each point of the file's triangles lies within ``weld``
+        of the solid, so a cover of the solid whose bodies grow by ``weld`` covers them.
     """
 
     boundary: NDArray[np.float64]
@@ -68,6 +78,7 @@ class Solid:
     source: str
     digest: str
     hull: bool = False
+    weld: float = 0.0
 
     @property
     def dimension(self) -> int:
@@ -149,6 +160,11 @@ def _mesh(source: str, suffix: str, scale: float, digest: str, hull: bool) -> So
     F = index.reshape(-1)[F]
     F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
     mesh = trimesh.Trimesh(V, F, process=False)
+    weld = 0.0
+    if not hull and not mesh.is_watertight:
+        welded = _welded(V, F, WELD_TOLERANCE * float(np.ptp(V, axis=0).max()))
+        if welded is not None and welded[0].is_watertight:
+            mesh, weld = welded
     if hull:
         try:
             mesh = mesh.convex_hull
@@ -176,7 +192,35 @@ def _mesh(source: str, suffix: str, scale: float, digest: str, hull: bool) -> So
     triangles = mesh.vertices[mesh.faces]
     # the geometry too: a .gltf's buffers live in other files than the one hashed
     digest = hashlib.sha256(digest.encode() + triangles.tobytes()).hexdigest()
-    return Solid(triangles, volume, mesh.vertices.copy(), mesh.faces.copy(), source, digest, hull)
+    return Solid(
+        triangles, volume, mesh.vertices.copy(), mesh.faces.copy(), source, digest, hull, weld
+    )
+
+
+def _welded(V: NDArray, F: NDArray, tolerance: float):
+    """``(mesh, moved)``: the mesh with corners closer than ``tolerance`` merged into the
+    first of their cluster, and the largest distance a corner moved; ``None`` when no
+    corners are that close or when a triangle would lose a corner (its points would then
+    not be within ``moved`` of the welded surface)."""
+    import trimesh
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(V).query_pairs(tolerance, output_type="ndarray")
+    if len(pairs) == 0:
+        return None
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(V),) * 2)
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, len(V))
+    np.minimum.at(first, label, np.arange(len(V)))
+    target = first[label]  # each corner's representative, a corner of the file
+    G = target[F]
+    if ((G[:, 0] == G[:, 1]) | (G[:, 1] == G[:, 2]) | (G[:, 0] == G[:, 2])).any():
+        return None
+    moved = float(np.linalg.norm(V - V[target], axis=1).max())
+    kept, index = np.unique(target, return_inverse=True)
+    return trimesh.Trimesh(V[kept], index[F], process=False), moved
 
 
 def _outline(source: str, data: bytes, suffix: str, scale: float, digest: str) -> Solid:
