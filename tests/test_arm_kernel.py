@@ -308,3 +308,24 @@ def test_a_self_colliding_end_is_not_remembered_as_valid(panda):
         assert not certifier.check(q, free[0])  # q1 is assumed valid: the guard finds it
         assert not certifier.state_valid(q)
     assert certifier.counters["rejected_guard"] == min(10, len(touching))
+
+
+def test_queries_between_edges_answer_as_a_fresh_world(panda, world, states):
+    """The kernel puts a body into the scene only when a query first needs it there, and
+    an edge's guards move bodies to other states: interleaved with edges, each state's
+    collision query and clearances are those of a world that never moved."""
+    from kcplan.arm.world import build_kernel_arm
+
+    kernel, fresh = KernelArmCertifier(world), build_kernel_arm(world)
+    free = [q for q in states if not world.in_collision(q)][:30]
+    tried = 0
+    for i, (q1, q2) in enumerate(zip(free, free[1:], strict=False)):
+        kernel.check(q1, q1 + 0.5 * (q2 - q1))  # guards and probes at other states
+        q = states[(7 * i) % len(states)]
+        assert world.kernel.in_collision(q.tolist()) == fresh.in_collision(q.tolist())
+        if i % 5 == 0:
+            got = world.kernel.safe_clearances(q.tolist())  # GJK's warm starts differ a hair
+            for a, b in zip(got, fresh.safe_clearances(q.tolist()), strict=True):
+                np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
+        tried += 1
+    assert tried == len(free) - 1 and kernel.counters["guards"] > 20

@@ -88,6 +88,9 @@ ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pa
       runs_.back().end = m + 1;
   }
   scene_ = std::make_unique<World>(bodies_of(chain), 1.0, rtol, atol);
+  frames_.resize(chain.bodies().size());
+  framed_.assign(chain.bodies().size(), 0);
+  placed_.assign(chain.bodies().size(), 0);
   for (const ChainBody& b : chain.bodies())
     shapes_.push_back(
         std::make_shared<coal::Ellipsoid>(b.semi_axes[0], b.semi_axes[1], b.semi_axes[2]));
@@ -95,19 +98,43 @@ ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pa
   hints_.assign(pairs.size(), coal::support_func_guess_t::Zero());
 }
 
-const std::vector<coal::Transform3s>& ArmWorld::place(const double* q) {
+void ArmWorld::locate(const double* q) {
   for (int j = 0; j < chain_.dof(); ++j)
     if (!std::isfinite(q[j]))
       throw std::invalid_argument("state: expected " + std::to_string(chain_.dof()) +
                                   " finite joint values");
-  chain_.body_frames(q, joints_, frames_);
+  chain_.joint_frames(q, joints_);
   parts_.place_bodies(joints_, part_frames_);
-  scene_->place_bodies(frames_.data());
+  ++located_;
+}
+
+const coal::Transform3s& ArmWorld::frame(std::size_t k) {
+  if (framed_[k] != located_) {
+    const ChainBody& b = chain_.bodies()[k];
+    frames_[k] = joints_[b.joint] * b.placement;
+    framed_[k] = located_;
+  }
+  return frames_[k];
+}
+
+void ArmWorld::put(std::size_t k) {
+  if (placed_[k] == located_) return;
+  scene_->place_body(k, frame(k));
+  placed_[k] = located_;
+}
+
+const std::vector<coal::Transform3s>& ArmWorld::place(const double* q) {
+  locate(q);
+  chain_.place_bodies(joints_, frames_);
+  std::fill(framed_.begin(), framed_.end(), located_);
   return frames_;
 }
 
 void ArmWorld::scene_clearances(double* out, const double* caps) {
-  if (caps == nullptr) return scene_->bodies_safe_clearances(out);
+  if (caps == nullptr) {
+    for (std::size_t k = 0; k < part_of_.size(); ++k) put(k);
+    return scene_->bodies_safe_clearances(out);
+  }
   ++scene_->counters.distance_queries;
   part_caps_.assign(parts_.bodies().size(), 0.0);
   for (std::size_t k = 0; k < part_of_.size(); ++k)
@@ -119,8 +146,14 @@ void ArmWorld::scene_clearances(double* out, const double* caps) {
                                                  part_caps_[p]);
     part_caps_[p] = d >= part_caps_[p] ? 1.0 : 0.0;  // now: whether the part is far
   }
-  for (std::size_t k = 0; k < part_of_.size(); ++k)
-    out[k] = part_caps_[part_of_[k]] > 0.0 ? caps[k] : scene_->capped_clearance(k, caps[k]);
+  for (std::size_t k = 0; k < part_of_.size(); ++k) {
+    if (part_caps_[part_of_[k]] > 0.0) {
+      out[k] = caps[k];
+      continue;
+    }
+    put(k);
+    out[k] = scene_->capped_clearance(k, caps[k]);
+  }
 }
 
 namespace {
@@ -202,7 +235,7 @@ double ArmWorld::pair_clearance(std::size_t m, const std::vector<coal::Transform
 }
 
 bool ArmWorld::in_collision(const double* q) {
-  const std::vector<coal::Transform3s>& frames = place(q);
+  locate(q);  // a body's frame only when a part's ball is near (frame(), put())
   // the scene: only the bodies of parts whose ball touches it
   ++scene_->counters.collision_queries;
   part_caps_.assign(parts_.bodies().size(), -1.0);  // per part: -1 not asked, 0 apart, 1 touches
@@ -213,17 +246,25 @@ bool ArmWorld::in_collision(const double* q) {
       ++part_queries;
       touches = scene_->ball_touches({c[0], c[1], c[2]}, parts_.bodies()[part_of_[k]].a_max);
     }
-    if (touches > 0.0 && scene_->body_collides(k)) return true;
+    if (touches > 0.0) {
+      put(k);
+      if (scene_->body_collides(k)) return true;
+    }
   }
   centres_.clear();
   for (const coal::Transform3s& f : part_frames_)
     for (int i = 0; i < 3; ++i) centres_.push_back(f.getTranslation()[i]);
+  near_.resize(groups_.size());
+  for (std::size_t g = 0; g < groups_.size(); ++g) near_[g] = !(group_gap(g, centres_.data()) > 0.0);
   for (const Run& run : runs_) {
-    if (group_gap(run.group, centres_.data()) > 0.0) continue;  // the parts' balls are apart
-    if (body_part_gap(run.body, frames, groups_[run.group][1], centres_.data()) > 0.0)
+    if (!near_[run.group]) continue;  // the parts' balls are apart
+    frame(run.body);
+    if (body_part_gap(run.body, frames_, groups_[run.group][1], centres_.data()) > 0.0)
       continue;  // the body's ball and the other part's are apart
-    for (std::size_t m = run.begin; m < run.end; ++m)
-      if (pair_collides(m, frames)) return true;
+    for (std::size_t m = run.begin; m < run.end; ++m) {
+      frame(pairs_[m][1]);
+      if (pair_collides(m, frames_)) return true;
+    }
   }
   return false;
 }

@@ -77,7 +77,9 @@ class ArmWorld {
   void safe_clearances(const double* q, double* scene, double* pairs);
 
   /// Place the bodies at q (no query) and return their frames; valid until the next
-  /// place().
+  /// place(). A body is put into the scene (its coal object moved, its box computed)
+  /// only when a query of this world first needs it there, so bodies of parts far from
+  /// the obstacles cost nothing more.
   const std::vector<coal::Transform3s>& place(const double* q);
   /// The joints' frames of the last place().
   const std::vector<coal::Transform3s>& joint_frames() const { return joints_; }
@@ -90,6 +92,7 @@ class ArmWorld {
   void scene_clearances(double* out, const double* caps = nullptr);
   /// min(cap, body k's certain clearance to the obstacles) with the bodies at `frames`.
   double body_clearance(std::size_t k, const std::vector<coal::Transform3s>& frames, double cap) {
+    placed_[k] = 0;  // it leaves the place of the last place()
     return scene_->body_safe_clearance(k, frames[k], cap);
   }
   /// Whether body k at `frames[k]`, grown about its centre by `scale` (semi-axes times
@@ -112,6 +115,12 @@ class ArmWorld {
 
  private:
   bool pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames);
+  /// The joints' and parts' frames at q; the bodies' frames and places become stale.
+  void locate(const double* q);
+  /// Body k's frame at the last locate(), computed on first use.
+  const coal::Transform3s& frame(std::size_t k);
+  /// Body k put into the scene at frame(k), if it is not there yet.
+  void put(std::size_t k);
 
   Chain chain_;
   std::vector<int> part_of_;  // before parts_: parts_ is built from it
@@ -123,6 +132,11 @@ class ArmWorld {
   std::vector<std::shared_ptr<coal::CollisionGeometry>> shapes_;
   std::vector<coal::Transform3s> joints_, frames_, part_frames_;
   std::vector<double> part_caps_, centres_;
+  // per body: the locate() whose frame it has, and whose frame it has in the scene (0:
+  // none; body_clearance moves it elsewhere)
+  std::vector<std::uint64_t> framed_, placed_;
+  std::uint64_t located_ = 0;
+  std::vector<char> near_;  // per group, in_collision: whether the parts' balls meet
   std::vector<coal::Vec3s> guesses_;  // per pair: where its last GJK ended
   std::vector<coal::support_func_guess_t> hints_;
 };

@@ -446,11 +446,13 @@ double World::distance(coal::CollisionObject& object, std::size_t shape) {
 }
 
 void World::place_bodies(const coal::Transform3s* frames) {
+  for (std::size_t k = 0; k < bodies_.size(); ++k) place_body(k, frames[k]);
+}
+
+void World::place_body(std::size_t k, const coal::Transform3s& frame) {
   if (!finalized_) finalize();
-  for (std::size_t k = 0; k < bodies_.size(); ++k) {
-    bodies_[k]->setTransform(frames[k]);
-    bodies_[k]->computeAABB();
-  }
+  bodies_[k]->setTransform(frame);
+  bodies_[k]->computeAABB();
 }
 
 bool World::in_collision(const Pose& pose) {
