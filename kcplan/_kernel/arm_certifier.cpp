@@ -35,6 +35,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   growth_.resize(speed_.size() * n_);
   pair_growth_.resize(pair_speed_.size());
   pair_edge_.assign(pair_speed_.size(), 0);
+  pair_growth_edge_.assign(pair_speed_.size(), 0);
   const std::vector<bool>& C = chain_.carries();
   for (const auto& [k, l] : world.pairs())
     for (int j = 0; j < n_; ++j) {
@@ -113,6 +114,9 @@ double ArmCertifier::kc_reach(const ArmGuard& guard, std::size_t k, Frames& fram
 template <class Frames>
 void ArmCertifier::body_radius(const ArmGuard& guard, std::size_t k, double enough, double& r,
                                Frames& frames) {
+  // the global speed alone may already give r (reach >= d / v): then nothing here can
+  // lower r, nor is anything refined (that needs a reach below r)
+  if (guard.scene[k] >= r * speed_[k]) return;
   double t = body_reach(guard, k, guard.scene[k]);
   if (kc_ > 0.0 && t < std::min(r, enough)) {
     const double kc = kc_reach(guard, k, frames);
@@ -139,32 +143,37 @@ void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double
   }
   const std::size_t m = k - bodies;
   const auto [a, b] = world_.pairs()[m];
-  pair_terms(m);
   for (int j = 0; j < n_; ++j)
     A += dq_[j] * (only_first_[m * n_ + j] * guard.levers[a * n_ + j] +
                    only_second_[m * n_ + j] * guard.levers[b * n_ + j]);
-  Q = pair_growth_[m];
+  Q = pair_growth(m);
 }
 
 double ArmCertifier::pair_reach(const ArmGuard& guard, std::size_t m, double d, double enough) {
   double A, Q;
   terms(guard, speed_.size() + m, A, Q);
-  const double t = reach(d, pair_speed_[m], A, Q);
+  const double t = reach(d, pair_speed(m), A, Q);
   if (!first_order_ || t >= enough) return t;  // the first order could only add to it
   return std::max(t, root(d, pair_first_.speed(m), pair_first_.accel(m)));
 }
 
-void ArmCertifier::pair_terms(std::size_t m) const {
-  if (pair_edge_[m] == edge_) return;
+double ArmCertifier::pair_speed(std::size_t m) const {
+  if (pair_edge_[m] == edge_) return pair_speed_[m];
   pair_edge_[m] = edge_;
-  const std::size_t dof = n_;
+  double v = 0.0;
+  for (int j = 0; j < n_; ++j) v += rho_pairs_[m * n_ + j] * dq_[j];
+  return pair_speed_[m] = v;
+}
+
+double ArmCertifier::pair_growth(std::size_t m) const {
+  if (pair_growth_edge_[m] == edge_) return pair_growth_[m];
+  pair_growth_edge_[m] = edge_;
   const auto [a, b] = world_.pairs()[m];
-  double v = 0.0, Q = 0.0;
-  for (std::size_t j = 0; j < dof; ++j) v += rho_pairs_[m * dof + j] * dq_[j];
-  for (std::size_t j = 0; j < dof; ++j)
-    Q += only_first_[m * dof + j] * growth_[a * dof + j] +
-         only_second_[m * dof + j] * growth_[b * dof + j];
-  pair_speed_[m] = v, pair_growth_[m] = Q;
+  double Q = 0.0;
+  for (int j = 0; j < n_; ++j)
+    Q += only_first_[m * n_ + j] * growth_[a * n_ + j] +
+         only_second_[m * n_ + j] * growth_[b * n_ + j];
+  return pair_growth_[m] = Q;
 }
 
 template <class Frames>
@@ -197,13 +206,16 @@ double ArmCertifier::group_reach(const ArmGuard& guard, std::size_t g) const {
 template <class Frames>
 void ArmCertifier::pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
                                Frames& frames) {
-  pair_terms(m);
-  const double v = pair_speed_[m];
+  const double v = pair_speed(m);
   if (!(v > 0.0)) return;
+  // as in body_radius: a lower bound of the distance that gives r at the global speed
+  // (the bounding balls' gap before the pair's own gap, which costs more) decides it
   if (!guard.pair_known[m]) {
+    if (world_.ball_gap(m, frames()) >= r * v) return;
     guard.pairs[m] = std::max(world_.pair_gap(m, frames()), 0.0);
     guard.pair_known[m] = 1;
   }
+  if (guard.pairs[m] >= r * v) return;
   double t = pair_reach(guard, m, guard.pairs[m], std::min(r, enough));
   if (guard.pair_known[m] == 1 && t < std::min(r, enough)) {
     guard.pairs[m] = std::max(guard.pairs[m], world_.pair_clearance(m, frames()));
@@ -380,7 +392,7 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
   if (first_order_ || kc_ > 0.0) chain_.point_accelerations(dq_.data(), accel_.data());
   if (kc_ > 0.0) chain_.turn_speeds(dq_.data(), turn_.data());
   if (first_order_) pair_first_.edge(step_.data());
-  ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_terms)
+  ++edge_;  // the pairs' speeds and growth: on first use for this edge (pair_speed, ...)
   if (part_balls_) {
     const Chain& parts = world_.parts();
     for (std::size_t g = 0; g < group_speed_.size(); ++g) {

@@ -216,10 +216,12 @@ class ArmCertifier {
   std::vector<coal::Vec3s> w_, u_;     // their twists there (twist())
   PairFirstOrder pair_first_;          // the pairs' first order (first_order)
   std::vector<double> turn_;           // per body: Chain::turn_speeds of the edge
-  /// Self pair m's speed and growth for the current edge, computed when first needed.
-  void pair_terms(std::size_t m) const;
+  /// Self pair m's speed v_kl and growth Q for the current edge, each computed when
+  /// first needed (a pair its speed decides never needs its growth).
+  double pair_speed(std::size_t m) const;
+  double pair_growth(std::size_t m) const;
   mutable std::vector<double> pair_speed_, pair_growth_;
-  mutable std::vector<std::uint64_t> pair_edge_;  // the edge pair m's terms are of
+  mutable std::vector<std::uint64_t> pair_edge_, pair_growth_edge_;  // the edge they are of
   std::uint64_t edge_ = 0;
   std::vector<double> rho_groups_, group_speed_, group_growth_, part_growth_, group_t_;
   std::vector<double> group_first_, group_second_;  // groups x dof: joint carries one part only

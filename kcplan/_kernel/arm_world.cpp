@@ -169,6 +169,13 @@ double half_width(const ChainBody& body, const coal::Transform3s& frame, const c
 
 }  // namespace
 
+double ArmWorld::ball_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
+  const auto [k, l] = pairs_[m];
+  const double a = chain_.bodies()[k].a_max, b = chain_.bodies()[l].a_max;
+  const double centres = (frames[l].getTranslation() - frames[k].getTranslation()).norm();
+  return centres - a - b - 1e-12 * (1.0 + centres + a + b);  // as pair_gap's rounding
+}
+
 double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
   const auto [k, l] = pairs_[m];
   const ChainBody &a = chain_.bodies()[k], &b = chain_.bodies()[l];

@@ -105,6 +105,9 @@ class ArmWorld {
   /// larger of the gap between their bounding balls and their separation along the
   /// centres' line (support functions), less rounding (<= 0: nothing known).
   double pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;
+  /// The gap between self pair m's bounding balls (centre, largest semi-axis) less
+  /// rounding: never above pair_gap, and cheaper.
+  double ball_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const;
   /// Self pair m's certain distance with the bodies at `frames` (coal's GJK, warm-started
   /// where the pair's last query ended, reduced by the allowance; 0 on contact).
   double pair_clearance(std::size_t m, const std::vector<coal::Transform3s>& frames);
