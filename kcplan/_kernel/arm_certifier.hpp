@@ -111,7 +111,9 @@ struct ArmCertifierOptions {
 /// could not lower that radius (each pair's distance is at least the balls' gap, each of
 /// its speeds, levers and growth at most the balls' from the parts' speed bounds, and the
 /// radius a clearance gives grows with the clearance and shrinks with the others), so
-/// the radius is the same.
+/// the radius is the same. For the same reason a body or pair whose clearance (for a
+/// pair not yet known: its bounding balls' gap first) already gives the radius at its
+/// global speed alone, d >= r v, is not looked at further.
 /// Not thread-safe (the world's objects are reused).
 class ArmCertifier {
  public:
