@@ -16,7 +16,7 @@ namespace kcplan {
 namespace {
 
 /// The chain's bodies as a Robot of ellipsoids at the robot frame's origin (each is placed
-/// by its own frame, World::place_bodies).
+/// by its own frame, World::place_body).
 Robot bodies_of(const Chain& chain) {
   std::vector<double> semi_axes, poses;
   for (const ChainBody& b : chain.bodies()) {

@@ -445,10 +445,6 @@ double World::distance(coal::CollisionObject& object, std::size_t shape) {
   return near.best;
 }
 
-void World::place_bodies(const coal::Transform3s* frames) {
-  for (std::size_t k = 0; k < bodies_.size(); ++k) place_body(k, frames[k]);
-}
-
 void World::place_body(std::size_t k, const coal::Transform3s& frame) {
   if (!finalized_) finalize();
   bodies_[k]->setTransform(frame);

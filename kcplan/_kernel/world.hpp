@@ -125,8 +125,6 @@ class World {
   /// piece touches a body.
   bool free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out);
   // -- the same queries for bodies placed one by one (an arm: each body by its own frame) --
-  /// Place body k at `frames[k]` (world frame; one frame per body, finite).
-  void place_bodies(const coal::Transform3s* frames);
   /// Place body k alone at `frame` (world frame, finite); the others stay where they are.
   void place_body(std::size_t k, const coal::Transform3s& frame);
   /// in_collision for the bodies as placed.
