@@ -291,6 +291,29 @@ def test_an_mbm_problem_is_read_with_its_obstacles_goal_and_allowed_pairs():
     assert frozenset(("panda_link0", "panda_hand")) not in problem.allowed
 
 
+UR5 = MBM.parents[1] / "ur5"
+UR5_GROUP = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+             "wrist_2_joint", "wrist_3_joint"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "urdf, group, bodies, pairs",
+    [(PANDA / "panda.urdf", GROUP, 287, 13184), (UR5 / "ur5.urdf", UR5_GROUP, 226, 14544)],
+    ids=["panda", "ur5"],
+)
+def test_the_default_covers_come_checked_from_the_bundle(
+    urdf, group, bodies, pairs, tmp_path, monkeypatch
+):
+    """Every machine plans MBM's robots with the same default cover (kcplan/cover/bundled),
+    and none is fitted: the benchmarks' body and pair counts, nothing written to the cache."""
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
+    lines: list[str] = []
+    arm = load_arm(urdf, group, srdf=urdf.with_suffix(".srdf"), progress=lines.append)
+    assert (len(arm.bodies), len(arm.self_pairs)) == (bodies, pairs)
+    assert lines and all(" bundled" in line and "fitted" not in line for line in lines)
+    assert not list(tmp_path.iterdir())
+
+
 def test_the_scenes_allowed_pairs_are_not_checked(panda):
     """The MBM scene allows link5 and the hand to touch: the world checks the SRDF's pairs
     less those; a wrist bent so that their covers overlap is then valid."""

@@ -562,6 +562,32 @@ def test_cache_fits_once_and_never_trusts_a_bad_entry(tmp_path, monkeypatch):
     assert len(list(cache_folder().glob("*.json"))) == 2
 
 
+def test_a_bundled_entry_is_checked_like_a_cached_one(tmp_path, monkeypatch):
+    """A bundled cover whose body no longer holds its piece is refitted into the cache."""
+    import kcplan.cover.cache as cache
+
+    panda = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "panda"
+    finger = panda / "meshes" / "collision" / "finger.obj"
+    bundled = cache.BUNDLED
+    monkeypatch.setattr(cache, "BUNDLED", tmp_path / "bundled")
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path / "cache"))
+    (tmp_path / "bundled").mkdir()
+    # not in this bundle: fitted into the cache
+    assert cached_cover(finger, None, max_offset=0.01)[1] == "fitted"
+    (entry,) = (tmp_path / "cache").glob("*.json")
+    assert (bundled / entry.name).is_file()  # the real bundle has it, under the same key
+    data = json.loads((bundled / entry.name).read_text())
+    entry.unlink()
+    (tmp_path / "bundled" / entry.name).write_text(json.dumps(data))
+    assert cached_cover(finger, None, max_offset=0.01)[1] == "bundled"
+    assert not (tmp_path / "cache" / entry.name).exists()
+    data["bodies"][0]["semi_axes"] = [0.5 * a for a in data["bodies"][0]["semi_axes"]]
+    (tmp_path / "bundled" / entry.name).write_text(json.dumps(data))
+    cover, origin = cached_cover(finger, None, max_offset=0.01)
+    assert origin == "refitted" and (tmp_path / "cache" / entry.name).is_file()
+    assert check_cover(cover.solid, cover.tree, cover.bodies) <= 1.0
+
+
 def test_an_unwritable_cache_only_costs_time(tmp_path, monkeypatch):
     blocker = tmp_path / "file"
     blocker.write_text("")

@@ -6,10 +6,12 @@ and of the fit's parameters (bodies, scale, shape, hull, max_offset,
 :data:`kcplan.cover.fit.FIT_VERSION`). An entry is never trusted for soundness: its bodies
 and cutting tree are re-derived and checked against the mesh
 (:func:`kcplan.cover.fit.check_cover`, the same hull points as the fit), and a stale,
-corrupt or failing entry is refitted and replaced. The offset bound of a ``max_offset``
-fit (:attr:`kcplan.cover.fit.Cover.offset`) is stored with the entry and read back as
-stored (re-proving it takes as long as a fit; no certificate relies on it). A cache folder that
-cannot be written is not an error; the cover is then fitted every time.
+corrupt or failing entry is refitted and replaced. :data:`BUNDLED`, the covers shipped
+with kcplan, is looked up first, and its entries are checked the same way. The offset
+bound of a ``max_offset`` fit (:attr:`kcplan.cover.fit.Cover.offset`) is stored with the
+entry and read back as stored (re-proving it takes as long as a fit; no certificate relies
+on it). A cache folder that cannot be written is not an error; the cover is then fitted
+every time.
 """
 
 from __future__ import annotations
@@ -27,7 +29,13 @@ from kcplan.cover.solid import Solid, read_solid
 from kcplan.files import write_text_atomic
 from kcplan.geometry.robot import MAX_BODIES, Body
 
-__all__ = ["cache_folder", "cached_cover"]
+__all__ = ["BUNDLED", "cache_folder", "cached_cover"]
+
+BUNDLED = Path(__file__).with_name("bundled")
+"""Entries shipped with kcplan (read only): the default covers of the links of
+MotionBenchMaker's Panda and UR5, fitted once (about 25 and 40 minutes) so that every
+machine plans with the same cover, whatever ties its floating point breaks otherwise in
+the greedy fit. Its README says how they were made."""
 
 
 def cache_folder() -> Path:
@@ -86,14 +94,15 @@ def cached_cover(
 ) -> tuple[Cover, str]:
     """The cover of the part in ``path`` by ``bodies`` bodies (or, with ``max_offset``,
     by at most ``bodies`` that stick out of it by at most ``max_offset``:
-    :func:`kcplan.cover.fit.fit_cover`), from the cache if a valid entry exists, else
-    fitted (and stored).
+    :func:`kcplan.cover.fit.fit_cover`), from the cache or :data:`BUNDLED` if a valid
+    entry exists there, else fitted (and stored in the cache).
 
     Returns
     -------
     cover : Cover
     origin : str
-        ``cached``, ``fitted`` or ``refitted`` (an entry existed but failed its check).
+        ``cached``, ``bundled`` (:data:`BUNDLED`), ``fitted`` or ``refitted`` (an entry
+        existed but failed its check).
 
     Raises
     ------
@@ -102,21 +111,22 @@ def cached_cover(
     """
     solid = read_solid(path, scale, hull)
     key = _key(solid, bodies, scale, shape, hull, max_offset)
-    file = cache_folder() / f"{key}.json"
     origin = "fitted"
-    if file.is_file():
-        try:
-            return _load(file, key, solid, shape), "cached"
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            origin = "refitted"
+    # the bundled entry first: every machine then plans with the same cover
+    for folder, found in ((BUNDLED, "bundled"), (cache_folder(), "cached")):
+        if (folder / f"{key}.json").is_file():
+            try:
+                return _load(folder / f"{key}.json", key, solid, shape), found
+            except (OSError, ValueError, KeyError, TypeError, AttributeError):
+                origin = "refitted"
     cover = fit_cover(solid, bodies=bodies, shape=shape, max_offset=max_offset)
     entry = {"key": key, "source": os.fspath(path), "note": cover.note}
     if not math.isnan(cover.offset):
         entry["offset"] = cover.offset
     entry |= {"bodies": cover.to_spec()["bodies"], "tree": cover.tree}
     try:
-        file.parent.mkdir(parents=True, exist_ok=True)
-        write_text_atomic(file, json.dumps(entry))
+        cache_folder().mkdir(parents=True, exist_ok=True)
+        write_text_atomic(cache_folder() / f"{key}.json", json.dumps(entry))
     except OSError:
         pass  # an unwritable cache only costs time
     return cover, origin
