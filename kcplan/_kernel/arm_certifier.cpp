@@ -33,6 +33,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   caps_.resize(speed_.size());
   dq_.resize(n_);
   growth_.resize(speed_.size() * n_);
+  body_growth_.resize(speed_.size());
   pair_growth_.resize(pair_speed_.size());
   pair_edge_.assign(pair_speed_.size(), 0);
   pair_growth_edge_.assign(pair_speed_.size(), 0);
@@ -137,8 +138,7 @@ void ArmCertifier::terms(const ArmGuard& guard, std::size_t k, double& A, double
   A = 0.0;
   if (k < bodies) {
     for (int j = 0; j < n_; ++j) A += dq_[j] * guard.levers[k * n_ + j];
-    Q = 0.0;
-    for (int j = 0; j < n_; ++j) Q += growth_[k * n_ + j];
+    Q = body_growth_[k];
     return;
   }
   const std::size_t m = k - bodies;
@@ -177,7 +177,8 @@ double ArmCertifier::pair_growth(std::size_t m) const {
 }
 
 template <class Frames>
-double ArmCertifier::run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames) {
+double ArmCertifier::run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames,
+                               double& speed) {
   const int g = run.group, k = run.body, q = world_.groups()[g][1];
   double v = 0.0, A = 0.0, Q = 0.0;
   for (int j = 0; j < n_; ++j) {
@@ -186,6 +187,7 @@ double ArmCertifier::run_reach(const ArmGuard& guard, const ArmWorld::Run& run, 
     A += dq_[j] * (first * guard.levers[k * n_ + j] + second * guard.part_levers[q * n_ + j]);
     Q += first * growth_[k * n_ + j] + second * part_growth_[q * n_ + j];
   }
+  speed = v;
   if (!(v > 0.0)) return std::numeric_limits<double>::infinity();
   const double gap = world_.body_part_gap(k, frames(), q, guard.part_centres.data());
   return reach(std::max(gap, 0.0), v, A, Q);
@@ -205,13 +207,16 @@ double ArmCertifier::group_reach(const ArmGuard& guard, std::size_t g) const {
 
 template <class Frames>
 void ArmCertifier::pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
-                               Frames& frames) {
+                               Frames& frames, double bound) {
+  // as in body_radius: a lower bound of the distance that gives r at the global speed
+  // (the bounding balls' gap before the pair's own gap, which costs more) decides it; at
+  // `bound`, above the speed, before the speed is summed
+  const double ball = guard.pair_known[m] ? 0.0 : world_.ball_gap(m, frames());
+  if (!guard.pair_known[m] && ball >= r * bound) return;
   const double v = pair_speed(m);
   if (!(v > 0.0)) return;
-  // as in body_radius: a lower bound of the distance that gives r at the global speed
-  // (the bounding balls' gap before the pair's own gap, which costs more) decides it
   if (!guard.pair_known[m]) {
-    if (world_.ball_gap(m, frames()) >= r * v) return;
+    if (ball >= r * v) return;
     guard.pairs[m] = std::max(world_.pair_gap(m, frames()), 0.0);
     guard.pair_known[m] = 1;
   }
@@ -288,6 +293,7 @@ void ArmCertifier::measure_into(const double* q, double enough, ArmGuard& g) {
   g.scene_exact.assign(bodies, !(enough > 0.0));
   g.pair_known.assign(pairs, 0);
   const std::vector<coal::Transform3s>& frames = world_.place(q);
+  g.location = world_.location();
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
   g.grown.assign(bodies, 0);
   if (first_order_ || kc_ > 0.0) {
@@ -335,10 +341,19 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
   double r = std::numeric_limits<double>::infinity();
   if (first_order_ || kc_ > 0.0) twist(guard);  // the bodies' twists here, for this edge
   if (first_order_) pair_first_.guard(guard.joints, guard.centres.data());
-  bool placed = false;
+  // the bodies' frames at the guard: the world's if it is still where the guard was
+  // measured (ArmGuard::location), else computed on first use
+  const std::vector<coal::Transform3s>* at = nullptr;
   const auto frames = [&]() -> const std::vector<coal::Transform3s>& {
-    if (!placed) chain_.body_frames(guard.q.data(), joints_, frames_), placed = true;
-    return frames_;
+    if (at == nullptr) {
+      if (guard.location != 0 && guard.location == world_.location()) {
+        at = &world_.placed_frames();
+      } else {
+        chain_.body_frames(guard.q.data(), joints_, frames_);
+        at = &frames_;
+      }
+    }
+    return *at;
   };
   // the measured clearances first; then a capped one that would hold r below what is
   // needed is refined (after the KC guard): the radius is then that of exact distances
@@ -347,7 +362,9 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
     for (std::size_t k = 0; k < bodies; ++k)
       if (speed_[k] > 0.0 && guard.scene_exact[k] == exact) body_radius(guard, k, enough, r, frames);
   if (!part_balls_) {
-    for (std::size_t m = 0; m < pair_speed_.size(); ++m) pair_radius(guard, m, enough, r, frames);
+    const double unknown = std::numeric_limits<double>::infinity();  // no bound but v
+    for (std::size_t m = 0; m < pair_speed_.size(); ++m)
+      pair_radius(guard, m, enough, r, frames, unknown);
     return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
   }
   // a group whose gap gives its pairs at least r cannot lower r (the class docs)
@@ -360,8 +377,9 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
       ++skipped_groups;
       continue;
     }
-    if (run_reach(guard, run, frames) >= r) continue;  // the body against the other part
-    for (std::size_t m = run.begin; m < run.end; ++m) pair_radius(guard, m, enough, r, frames);
+    double v;  // the run's speed: at least each of its pairs'
+    if (run_reach(guard, run, frames, v) >= r) continue;  // the body against the other part
+    for (std::size_t m = run.begin; m < run.end; ++m) pair_radius(guard, m, enough, r, frames, v);
   }
   return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
 }
@@ -389,6 +407,11 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     speed_[k] = v;
   }
   chain_.lever_growth(dq_.data(), growth_.data());
+  for (std::size_t k = 0; k < speed_.size(); ++k) {
+    double Q = 0.0;
+    for (std::size_t j = 0; j < dof; ++j) Q += growth_[k * dof + j];
+    body_growth_[k] = Q;
+  }
   if (first_order_ || kc_ > 0.0) chain_.point_accelerations(dq_.data(), accel_.data());
   if (kc_ > 0.0) chain_.turn_speeds(dq_.data(), turn_.data());
   if (first_order_) pair_first_.edge(step_.data());

@@ -29,6 +29,9 @@ namespace kcplan {
 struct ArmGuard {
   std::array<double, Chain::kMaxJoints> q{};
   std::vector<double> levers;        ///< Chain::levers at q: bodies x dof
+  /// ArmWorld::location() right after its place(q): while the world is there, its frames
+  /// are this guard's bodies' (radius() then computes none).
+  std::uint64_t location = 0;
   std::vector<coal::Transform3s> joints;  ///< the joints' frames at q (first_order)
   std::vector<double> centres;            ///< the bodies' centres at q, 3 each (first_order)
   std::vector<double> part_levers;   ///< the same of ArmWorld::parts(): parts x dof
@@ -113,7 +116,8 @@ struct ArmCertifierOptions {
 /// radius a clearance gives grows with the clearance and shrinks with the others), so
 /// the radius is the same. For the same reason a body or pair whose clearance (for a
 /// pair not yet known: its bounding balls' gap first) already gives the radius at its
-/// global speed alone, d >= r v, is not looked at further.
+/// global speed alone, d >= r v, is not looked at further; nor a pair whose balls' gap
+/// gives it at its run's speed, which is at least its own.
 /// Not thread-safe (the world's objects are reused).
 class ArmCertifier {
  public:
@@ -201,19 +205,23 @@ class ArmCertifier {
   void terms(const ArmGuard& guard, std::size_t k, double& A, double& Q) const;
   /// The radius group g's gap gives all its pairs, for the current edge.
   double group_reach(const ArmGuard& guard, std::size_t g) const;
-  /// The same of one run's pairs: its body's ball against the other part's.
+  /// The same of one run's pairs: its body's ball against the other part's; `speed` is
+  /// set to the run's global speed, at least each of its pairs' (pair_speed).
   template <class Frames>
-  double run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames);
+  double run_reach(const ArmGuard& guard, const ArmWorld::Run& run, Frames& frames,
+                   double& speed);
   /// Self pair m's part of radius(): its bound asked if not known, refined if it would
-  /// hold r below min(r, enough), then r lowered to what it gives.
-  /// `frames()` gives the bodies' frames at the guard (computed on first use).
+  /// hold r below min(r, enough), then r lowered to what it gives. `bound` is at least
+  /// pair_speed(m) (its run's, or infinity). `frames()` gives the bodies' frames at the
+  /// guard (computed on first use).
   template <class Frames>
   void pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
-                   Frames& frames);
+                   Frames& frames, double bound);
 
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
   std::vector<double> speed_, q_, caps_, dq_, growth_, step_, accel_;
+  std::vector<double> body_growth_;  // per body: Q of the current edge (the sum of growth_)
   mutable std::vector<double> first_;  // A1 of the bodies at the guard of the radius asked
   std::vector<coal::Vec3s> w_, u_;     // their twists there (twist())
   PairFirstOrder pair_first_;          // the pairs' first order (first_order)

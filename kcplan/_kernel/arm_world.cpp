@@ -167,13 +167,30 @@ double half_width(const ChainBody& body, const coal::Transform3s& frame, const c
                    a[2] * a[2] * local[2] * local[2]);
 }
 
+/// What the rounding of a gap between two balls of radii ra and rb whose centres are
+/// `between` apart may take off it: below 1e-12 of the numbers involved.
+double gap_rounding(double between, double ra, double rb) {
+  return 1e-12 * (1.0 + between + ra + rb);
+}
+
+/// A certain lower bound of the distance between anything inside those two balls.
+double balls_gap(double between, double ra, double rb) {
+  return between - ra - rb - gap_rounding(between, ra, rb);
+}
+
+/// |c - centres[3 q .. 3 q + 2]|, for centres stored three to a part.
+double distance_to(const coal::Vec3s& c, const double* centres, int q) {
+  const double dx = c[0] - centres[3 * q], dy = c[1] - centres[3 * q + 1],
+               dz = c[2] - centres[3 * q + 2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
 }  // namespace
 
 double ArmWorld::ball_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
   const auto [k, l] = pairs_[m];
   const double a = chain_.bodies()[k].a_max, b = chain_.bodies()[l].a_max;
-  const double centres = (frames[l].getTranslation() - frames[k].getTranslation()).norm();
-  return centres - a - b - 1e-12 * (1.0 + centres + a + b);  // as pair_gap's rounding
+  return balls_gap((frames[l].getTranslation() - frames[k].getTranslation()).norm(), a, b);
 }
 
 double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
@@ -190,31 +207,25 @@ double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& f
     const coal::Vec3s n = between / centres;
     gap = std::max(gap, centres - half_width(a, frames[k], n) - half_width(b, frames[l], n));
   }
-  // the gap's rounding is below 1e-12 of the numbers involved
-  return gap - 1e-12 * (1.0 + centres + a.a_max + b.a_max);
+  return gap - gap_rounding(centres, a.a_max, b.a_max);
 }
 
 double ArmWorld::group_gap(std::size_t g, const double* centres) const {
   const auto [p, q] = groups_[g];
-  const double ra = parts_.bodies()[p].a_max, rb = parts_.bodies()[q].a_max;
-  const double dx = centres[3 * p] - centres[3 * q], dy = centres[3 * p + 1] - centres[3 * q + 1],
-               dz = centres[3 * p + 2] - centres[3 * q + 2];
-  const double between = std::sqrt(dx * dx + dy * dy + dz * dz);
-  return between - ra - rb - 1e-12 * (1.0 + between + ra + rb);
+  const coal::Vec3s c(centres[3 * p], centres[3 * p + 1], centres[3 * p + 2]);
+  return balls_gap(distance_to(c, centres, q), parts_.bodies()[p].a_max,
+                   parts_.bodies()[q].a_max);
 }
 
 double ArmWorld::body_part_gap(std::size_t k, const std::vector<coal::Transform3s>& frames, int q,
                                const double* centres) const {
-  const double ra = chain_.bodies()[k].a_max, rb = parts_.bodies()[q].a_max;
-  const coal::Vec3s& c = frames[k].getTranslation();
-  const double dx = c[0] - centres[3 * q], dy = c[1] - centres[3 * q + 1],
-               dz = c[2] - centres[3 * q + 2];
-  const double between = std::sqrt(dx * dx + dy * dy + dz * dz);
-  return between - ra - rb - 1e-12 * (1.0 + between + ra + rb);
+  return balls_gap(distance_to(frames[k].getTranslation(), centres, q), chain_.bodies()[k].a_max,
+                   parts_.bodies()[q].a_max);
 }
 
 bool ArmWorld::pair_collides(std::size_t m, const std::vector<coal::Transform3s>& frames) {
-  if (pair_gap(m, frames) > 0.0) return false;
+  // the balls' gap first: it costs less, and pair_gap is never below it
+  if (ball_gap(m, frames) > 0.0 || pair_gap(m, frames) > 0.0) return false;
   ++pair_queries;
   const auto [k, l] = pairs_[m];
   coal::CollisionRequest request = collision_request();

@@ -81,6 +81,12 @@ class ArmWorld {
   /// only when a query of this world first needs it there, so bodies of parts far from
   /// the obstacles cost nothing more.
   const std::vector<coal::Transform3s>& place(const double* q);
+  /// Which place() (or other query) this world is at: changes at each. While it stays
+  /// what it was right after place(q), that call's frames are still the bodies' at q.
+  std::uint64_t location() const { return located_; }
+  /// The frames the last place() returned: the bodies' there while location() is still
+  /// what it was right after it (later queries may recompute some of them otherwise).
+  const std::vector<coal::Transform3s>& placed_frames() const { return frames_; }
   /// The joints' frames of the last place().
   const std::vector<coal::Transform3s>& joint_frames() const { return joints_; }
   /// The parts' frames of the last place() (their balls' centres).
