@@ -94,8 +94,8 @@ def cached_cover(
 ) -> tuple[Cover, str]:
     """The cover of the part in ``path`` by ``bodies`` bodies (or, with ``max_offset``,
     by at most ``bodies`` that stick out of it by at most ``max_offset``:
-    :func:`kcplan.cover.fit.fit_cover`), from the cache or :data:`BUNDLED` if a valid
-    entry exists there, else fitted (and stored in the cache).
+    :func:`kcplan.cover.fit.fit_cover`), from :data:`BUNDLED` or else the cache if a
+    valid entry exists there, else fitted (and stored in the cache).
 
     Returns
     -------
@@ -113,7 +113,8 @@ def cached_cover(
     key = _key(solid, bodies, scale, shape, hull, max_offset)
     origin = "fitted"
     # the bundled entry first: every machine then plans with the same cover
-    for folder, found in ((BUNDLED, "bundled"), (cache_folder(), "cached")):
+    cache = cache_folder()
+    for folder, found in ((BUNDLED, "bundled"), (cache, "cached")):
         if (folder / f"{key}.json").is_file():
             try:
                 return _load(folder / f"{key}.json", key, solid, shape), found
@@ -125,8 +126,8 @@ def cached_cover(
         entry["offset"] = cover.offset
     entry |= {"bodies": cover.to_spec()["bodies"], "tree": cover.tree}
     try:
-        cache_folder().mkdir(parents=True, exist_ok=True)
-        write_text_atomic(cache_folder() / f"{key}.json", json.dumps(entry))
+        cache.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(cache / f"{key}.json", json.dumps(entry))
     except OSError:
         pass  # an unwritable cache only costs time
     return cover, origin
