@@ -12,8 +12,15 @@ from hypothesis import strategies as st
 settings.register_profile("default", deadline=None, print_blob=True)
 settings.load_profile("default")
 
-# covers of mesh robots are cached per user; the tests keep theirs apart (and start cold)
-os.environ["KCPLAN_CACHE_DIR"] = tempfile.mkdtemp(prefix="kcplan-test-cache-")
+# covers of mesh robots are cached per user; the tests keep theirs apart (and start cold),
+# one cache per test run: pytest-xdist's workers share it (entries are written atomically)
+_RUN = os.environ.get("PYTEST_XDIST_TESTRUNUID")
+if _RUN:
+    _CACHE = Path(tempfile.gettempdir()) / f"kcplan-test-cache-{_RUN}"
+    _CACHE.mkdir(exist_ok=True)
+    os.environ["KCPLAN_CACHE_DIR"] = str(_CACHE)
+else:
+    os.environ["KCPLAN_CACHE_DIR"] = tempfile.mkdtemp(prefix="kcplan-test-cache-")
 
 
 @st.composite
