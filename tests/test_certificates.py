@@ -9,12 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from kcplan.geometry.pose import Edge
+from kcplan.geometry.pose import Edge, rotate_vector
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
 from kcplan.planning.guard import BodyGuard, Guard, GuardCache
 from kcplan.world import CollisionWorld, parse_scenario
-from kcplan.world.clutter import random_pose, random_scenario
+from kcplan.world.clutter import random_pose, random_robot, random_scenario
 from kcplan.world.occupancy import CoreOccupancy
 
 axes2 = st.lists(st.floats(0.1, 10.0), min_size=2, max_size=2)
@@ -77,6 +77,86 @@ def test_lever_is_tight_in_2d():
     h = np.hypot(a[0] * np.cos(phis), a[1] * np.sin(phis))
     rate = np.abs(np.diff(h)) / np.diff(phis)
     assert rate.max() == pytest.approx(a.max() - a.min(), rel=1e-3)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    n=st.sampled_from([2, 3]),
+    q=st.lists(unit, min_size=8, max_size=8),
+    p=st.tuples(st.floats(-5, 5), st.floats(-5, 5), st.floats(-5, 5)),
+    m=st.floats(0.0, 1.0),
+    s=st.floats(0.0, 1.0),
+)
+def test_an_offset_centre_stays_within_the_arc_rules_remainder(n, q, p, m, s):
+    """``|R(s) p - R(m) p - (s - m) spin x R(m) p| <= |p| ((s - m) |spin|)^2 / 2`` along
+    an edge's own interpolation (region.py's arc rule; ``Edge.spin`` is the angular
+    velocity in the world frame)."""
+    if n == 2:
+        p1, p2 = np.array([0.0, 0.0, 3.2 * q[0]]), np.array([1.0, 0.0, 3.2 * q[1]])
+        p = np.array([p[0], p[1], 0.0])
+    else:
+        if min(np.linalg.norm(q[:4]), np.linalg.norm(q[4:])) < 1e-2:
+            return
+        p1, p2 = np.r_[0.0, 0.0, 0.0, q[:4]], np.r_[1.0, 0.0, 0.0, q[4:]]
+        p = np.array(p)
+    edge = Edge(p1, p2, n)
+
+    def arm(x):  # R(x) p, the body's offset from the robot's origin at q(x)
+        frame = edge.pose(x)
+        if n == 2:
+            c, si = math.cos(frame[2]), math.sin(frame[2])
+            return np.array([c * p[0] - si * p[1], si * p[0] + c * p[1], 0.0])
+        return np.array(rotate_vector(frame[3:] / np.linalg.norm(frame[3:]), p))
+
+    spin, x = np.array(edge.spin), s - m
+    assert np.linalg.norm(spin) == pytest.approx(edge.rotation_speed, abs=1e-12)
+    error = arm(s) - arm(m) - x * np.cross(spin, arm(m))
+    bound = np.linalg.norm(p) * (x * edge.rotation_speed) ** 2 / 2
+    assert np.linalg.norm(error) <= bound + 1e-9 * (1.0 + np.linalg.norm(p))
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_the_arc_rule_reaches_at_least_the_lever_rule_and_stays_free(n):
+    """Robots of 2 or 3 bodies offset up to 3 from their origin in random clutter: from
+    each guard the arc rule (``region``) reaches at least as far as the lever rule
+    (``region-lever``) on both sides, and its reach is free on dense samples. It is the
+    longer forward reach (by over 1 %) from more than a fifth of the guards, and by over
+    15 % from a tenth (measured: 29 % of the guards and 27 % longer at the 90th
+    percentile in 2D, 43 % and 42 % in 3D)."""
+    rng = np.random.default_rng(40 + n)
+    gains, tested = [], 0
+    for _ in range(8):
+        robot = random_robot(rng, n, int(rng.integers(2, 4)))
+        world = CollisionWorld(random_scenario(rng, n, robot, 8, half_width=20.0))
+        arc, lever = FreeRegionPlanes(robot), FreeRegionPlanes(robot, arc=False)
+        assert (arc.name, lever.name) == ("region", "region-lever")
+        for _ in range(60):
+            p1 = random_pose(rng, n, -18, 18)
+            if world.in_collision(p1):
+                continue
+            p2 = p1.copy()
+            p2[:n] += rng.normal(0, 3.0, n)
+            p2[n:] = random_pose(rng, n, 0, 1)[n:]
+            edge = Edge(p1, p2, n)
+            m = float(rng.uniform(0, 1))
+            g = edge.pose(m)
+            guard = Guard.from_regions(
+                g, world.free_regions(g, 4.0), world.robot, world.clearance_atol
+            )
+            if guard.clearance <= 0.0:
+                continue
+            minus, plus = arc.reach(guard, edge, m)
+            old_minus, old_plus = lever.reach(guard, edge, m)
+            assert minus >= old_minus and plus >= old_plus
+            assert dense_free(world, edge, m - minus, m + plus)
+            gains.append(min(plus, 1.0 - m) / max(min(old_plus, 1.0 - m), 1e-12))
+            tested += 1
+    assert tested > 100
+    gains = np.array(gains)
+    assert np.mean(gains > 1.01) > 0.2 and np.percentile(gains, 90) > 1.15, (
+        np.mean(gains > 1.01),
+        np.percentile(gains, [50, 75, 90]),
+    )
 
 
 # ------------------------------------------------------------- region queries

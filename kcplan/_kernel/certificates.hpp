@@ -56,33 +56,58 @@ class ClearanceBall final : public Certificate {
 };
 
 /// Separating planes of every piece within each body's horizon: piece i stays on its side
-/// while sigma_i + (s - m) n_i . dt - |s - m| L_k |w| > 0, or within its clearance ball;
-/// pieces beyond the horizon are covered by the ball of radius `horizon`.
+/// while its slack lasts, or within its clearance ball; pieces beyond the horizon are
+/// covered by the ball of radius `horizon`. How body k's centre may move in x = s - m:
+/// "region-lever" by at most |x| (|dt| + |p_k| |w|), the lever rule; "region" by
+/// x (dt + w x R p_k) to first order and within |p_k| (x |w|)^2 / 2 of that, the arc rule,
+/// each reach the larger of the two rules' (proofs in region.py).
 class FreeRegionPlanes final : public Certificate {
  public:
-  explicit FreeRegionPlanes(const Robot& robot) {
-    for (const Body& b : robot.bodies()) levers_.push_back(b.lever());
+  FreeRegionPlanes(const Robot& robot, bool arc) : arc_(arc) {
+    for (const Body& b : robot.bodies()) {
+      levers_.push_back(b.lever());
+      shape_levers_.push_back(b.a_max - b.a_min);
+      offsets_.push_back(b.offset());
+    }
   }
-  const char* name() const override { return "region"; }
+  const char* name() const override { return arc_ ? "region" : "region-lever"; }
   void reach(const Guard& guard, const Edge& edge, double, double& minus,
              double& plus) const override {
     minus = plus = kInf;
     const double v = edge.translation_speed(), w = edge.rotation_speed();
     const std::array<double, 3>& dt = edge.dt();
+    const std::array<double, 3> spin = edge.spin();
     for (std::size_t k = 0; k < levers_.size(); ++k) {
       const BodyGuard& body = guard.bodies[k];
       const double turn = levers_[k] * w, speed = v + turn;
       if (speed <= 0.0) continue;
-      const double horizon = body.horizon / speed;
+      // the arc rule: the centre's velocity c' = dt + w x R p_k, and its curvature term
+      const std::array<double, 3>& r = body.arm;
+      const double swing[3] = {spin[1] * r[2] - spin[2] * r[1], spin[2] * r[0] - spin[0] * r[2],
+                               spin[0] * r[1] - spin[1] * r[0]};
+      const double cx = dt[0] + swing[0], cy = dt[1] + swing[1], cz = dt[2] + swing[2];
+      const double shape_turn = shape_levers_[k] * w;
+      const double bend = arc_ ? 0.5 * offsets_[k] * w * w : kInf;
+      const double arc_speed = std::sqrt(cx * cx + cy * cy + cz * cz) + shape_turn;
+      // how long the body stays within distance d of where it is at m
+      const auto within = [&](double d) {
+        return std::max(d / speed, arc_reach(d, arc_speed, bend));
+      };
+      const double horizon = within(body.horizon);
       plus = std::min(plus, horizon), minus = std::min(minus, horizon);
       for (const PlaneRow& p : body.planes) {
-        const double ball = p.clearance / speed;
+        const double ball = within(p.clearance);
         if (p.slack > 0.0) {
           const double along = p.nx * dt[0] + p.ny * dt[1] + p.nz * dt[2];
+          const double towards = p.nx * cx + p.ny * cy + p.nz * cz;  // n . c'
           double rate = turn - along;  // slack used up per unit s going forward
-          const double ahead = rate > 0.0 ? p.slack / rate : kInf;
+          const double ahead =
+              std::max(rate > 0.0 ? p.slack / rate : kInf,
+                       arc_reach(p.slack, shape_turn - towards, bend));
           rate = turn + along;  // ... going backward
-          const double behind = rate > 0.0 ? p.slack / rate : kInf;
+          const double behind =
+              std::max(rate > 0.0 ? p.slack / rate : kInf,
+                       arc_reach(p.slack, shape_turn + towards, bend));
           plus = std::min(plus, std::max(ahead, ball));
           minus = std::min(minus, std::max(behind, ball));
         } else {
@@ -93,7 +118,19 @@ class FreeRegionPlanes final : public Certificate {
   }
 
  private:
-  std::vector<double> levers_;
+  /// The least x > 0 with budget - rate x - bend x^2 = 0 (inf when there is none); 0 for
+  /// no budget, and without the arc rule (bend = inf).
+  static double arc_reach(double budget, double rate, double bend) {
+    if (bend == kInf || !(budget > 0.0)) return 0.0;
+    if (budget == kInf) return kInf;
+    if (bend <= 0.0) return rate > 0.0 ? budget / rate : kInf;
+    const double root = std::sqrt(rate * rate + 4.0 * bend * budget);
+    // each form free of cancellation on its side of rate = 0
+    return rate > 0.0 ? 2.0 * budget / (rate + root) : (root - rate) / (2.0 * bend);
+  }
+
+  bool arc_;
+  std::vector<double> levers_, shape_levers_, offsets_;
 };
 
 /// The paper's convex lower bound P_eps of the largest free guard (1 + eps) E_a on a

@@ -12,12 +12,13 @@ EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
       domain_(world.robot().dimension(), options.low, options.high, world.robot().reach()),
       cache_(options.cache_entries) {
   if (options.certificates.empty())
-    throw std::invalid_argument("certificates: expected names from ball, rotation, polytope, region");
+    throw std::invalid_argument(
+        "certificates: expected names from ball, rotation, polytope, region, region-lever");
   for (const std::string& name : options.certificates) {
     if (name == "ball" || name == "rotation") {
       certificates_.push_back(std::make_unique<ClearanceBall>(robot_, name == "rotation"));
-    } else if (name == "region") {
-      certificates_.push_back(std::make_unique<FreeRegionPlanes>(robot_));
+    } else if (name == "region" || name == "region-lever") {
+      certificates_.push_back(std::make_unique<FreeRegionPlanes>(robot_, name == "region"));
       use_region_ = true;
     } else if (name == "polytope") {
       if (!robot_.is_single())
@@ -28,7 +29,7 @@ EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
       certificates_.push_back(std::move(polytope));
     } else {
       throw std::invalid_argument("certificates: expected names from ball, rotation, polytope, "
-                                  "region, got '" + name + "'");
+                                  "region, region-lever, got '" + name + "'");
     }
   }
   if (max_guards_ < 0) throw std::invalid_argument("max_guards: expected a number >= 0");

@@ -50,7 +50,7 @@ struct CertifierCounters {
 
 /// Options of an EdgeCertifier; the defaults are the Python certifier's.
 struct CertifierOptions {
-  std::vector<std::string> certificates{"region"};  ///< ball, rotation, polytope, region
+  std::vector<std::string> certificates{"region"};  ///< ball, rotation, polytope, region(-lever)
   bool discrete = false;     ///< fallback: OMPL-style sampling instead of advancement
   int max_guards = 64;       ///< guards per edge after the endpoints before "not proven"
   double horizon = -1.0;     ///< region horizon; < 0: the largest semi-axis

@@ -27,11 +27,13 @@ struct PlaneRow {
 };
 
 /// What a guard knows about one body: its clearance (never an overestimate), the planes
-/// of the pieces within `horizon` (region guards only), and that horizon.
+/// of the pieces within `horizon` and its centre's offset from the robot's origin, R p_k
+/// (region guards only), and that horizon.
 struct BodyGuard {
   double clearance = 0.0;
   double horizon = 0.0;
   std::vector<PlaneRow> planes;
+  std::array<double, 3> arm{0.0, 0.0, 0.0};
 };
 
 /// Measurements at one robot pose, one BodyGuard per body, in the robot's order.
@@ -86,6 +88,7 @@ struct Guard {
       }
       body.clearance = region.clearance();
       body.horizon = region.horizon;
+      for (int i = 0; i < 3; ++i) body.arm[i] = c[i] - pose.t[i];
       g.clearance = std::min(g.clearance, body.clearance);
     }
     return g;

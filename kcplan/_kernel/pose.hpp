@@ -113,6 +113,13 @@ class Edge {
   /// |w12|: radians per unit s.
   double rotation_speed() const { return rotation_speed_; }
   const std::array<double, 3>& dt() const { return dt_; }
+  /// The angular velocity w in the world frame, radians per unit s, constant along the
+  /// edge (R(s) = exp((s - m) [w]) R(m)); (0, 0, turn) in 2D.
+  std::array<double, 3> spin() const {
+    if (two_d_) return {0.0, 0.0, turn_};
+    const std::array<double, 3> a = q1_.rotate(axis_);
+    return {a[0] * angle_, a[1] * angle_, a[2] * angle_};
+  }
 
   /// The pose q(s), with the flat numbers OMPL's interpolation would give (yaw wrapped to
   /// [-pi, pi) as Python's modulo does).

@@ -158,6 +158,13 @@ class Edge:
         ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``.
     n : int
         2 or 3.
+
+    Attributes
+    ----------
+    spin : tuple of 3 floats
+        The angular velocity in the world frame, radians per unit ``s`` (``R1 w12``;
+        ``(0, 0, turn)`` in 2D), the same at every ``s``: ``R(s) = exp((s - m)
+        hat(spin)) R(m)``.
     """
 
     __slots__ = (
@@ -171,6 +178,7 @@ class Edge:
         "angle",
         "translation_speed",
         "rotation_speed",
+        "spin",
     )
 
     def __init__(self, pose1: ArrayLike, pose2: ArrayLike, n: int):
@@ -183,6 +191,7 @@ class Edge:
             turn = so2_difference(float(p1[2]), float(p2[2]))
             self.w = np.array([turn])
             self.rotation_speed = abs(turn)  # radians per unit s
+            self.spin = (0.0, 0.0, turn)
             return
         # plain floats: numpy costs microseconds per call on 4-vectors
         a1, b1, c1, d1 = (float(v) for v in p1[3:])
@@ -200,6 +209,8 @@ class Edge:
         self.axis = (rx / norm, ry / norm, rz / norm) if norm > 0.0 else (1.0, 0.0, 0.0)
         self.w = np.array(self.axis) * self.angle
         self.rotation_speed = abs(self.angle)
+        x, y, z = rotate_vector(q1, self.axis)
+        self.spin = (x * self.angle, y * self.angle, z * self.angle)
 
     def sweep_speed(self, radius: float) -> float:
         """Bound on how fast any point within ``radius`` of the robot's centre moves, per

@@ -40,8 +40,10 @@ CERTIFICATE_SETS = {
     "ca": ("ball",),
     "kc-paper": ("polytope",),
     "kc": ("region",),
+    "kc-lever": ("region-lever",),
 }
-"""The certificate sets of the ablation planners (``ca-*``, ``kc-*-paper``, ``kc-*``).
+"""The certificate sets of the ablation planners (``ca-*``, ``kc-*-paper``, ``kc-*``,
+``kc-*-lever``).
 ``region`` includes a rotation-aware clearance ball per obstacle piece, so ``rotation``
 adds nothing to it; added to it, ``polytope`` won at most 0.001 % of the certified edge
 parameter on the six narrow passages (``benchmarks/RESULTS.md``, section 0.1), so it is
@@ -206,8 +208,8 @@ class EdgeCertifier:
             elif name == "polytope":
                 self.certificates.append(KCPolytope(ladder or GuardLadder(robot.semi_axes)))
             else:
-                self.certificates.append(FreeRegionPlanes(robot))
-        self.use_region = "region" in certificates
+                self.certificates.append(FreeRegionPlanes(robot, arc=name == "region"))
+        self.use_region = any(name.startswith("region") for name in certificates)
         largest = robot.largest_semi_axis
         self.horizon = float(largest if horizon is None else horizon)
         self.margin = float(getattr(world, "clearance_atol", 0.0)) + 1e-12 * robot.reach
@@ -482,8 +484,11 @@ def check_certificates(
 ) -> None:
     """Raise ``ValueError`` (one line) unless the certificate names, the robot and the
     fallback fit together; ``regions``: the world offers region queries."""
-    if "region" in certificates and not regions:
-        raise ValueError("certificates: 'region' needs a world with free_regions(pose, horizon)")
+    for name in ("region", "region-lever"):
+        if name in certificates and not regions:
+            raise ValueError(
+                f"certificates: {name!r} needs a world with free_regions(pose, horizon)"
+            )
     if "polytope" in certificates and not robot.is_single:
         raise ValueError(
             "certificates: 'polytope' (the paper's bound) needs one body centred at the "

@@ -38,11 +38,15 @@ class BodyGuard(NamedTuple):
         the body's clearance to the piece.
     horizon : float
         Every piece not listed is at least this far from the body.
+    arm : tuple of 3 floats
+        ``R p``: the body's centre less the robot's origin, in the world frame (region
+        guards; ``(0, 0, 0)`` otherwise).
     """
 
     clearance: float
     planes: tuple = ()
     horizon: float = 0.0
+    arm: tuple = (0.0, 0.0, 0.0)
 
 
 class Guard:
@@ -98,6 +102,7 @@ class Guard:
         bodies = []
         # one body at the origin (the common case) is at the robot's pose: no numpy
         body_poses = [pose.tolist()] if robot.is_single else robot.body_poses(pose).tolist()
+        origin = pose.tolist()[:n] + pad
         for body_pose, body, region in zip(body_poses, robot.bodies, regions, strict=True):
             a = [float(v) for v in body.semi_axes] + pad
             if n == 2:  # a yaw is a rotation about z: the 3D formula serves
@@ -122,7 +127,8 @@ class Guard:
                     h = math.sqrt((a[0] * ux) ** 2 + (a[1] * uy) ** 2 + (a[2] * uz) ** 2)
                     slack = nx * c[0] + ny * c[1] + nz * c[2] - h - offset - margin
                 rows.append((nx, ny, nz, slack, d))
-            bodies.append(BodyGuard(region.clearance, tuple(rows), region.horizon))
+            arm = (c[0] - origin[0], c[1] - origin[1], c[2] - origin[2])
+            bodies.append(BodyGuard(region.clearance, tuple(rows), region.horizon, arm))
         return cls(pose, tuple(bodies))
 
 

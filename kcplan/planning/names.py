@@ -56,6 +56,7 @@ PLANNER_NAMES = (
     "kc-prm-paper",
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",
+    "kc-rrtconnect-lever",
     "kc-rrtconnect-noparts",
     "kc-rrtconnect-nofirst",
     "kc-prm-noprobe",

@@ -121,6 +121,13 @@ PLANNERS: dict[str, PlannerSpec] = {
         description="ablation: kc-rrtconnect without collision probes before the guards",
         probes=0,
     ),
+    "kc-rrtconnect-lever": PlannerSpec(
+        og.RRTConnect,
+        CERTIFICATE_SETS["kc-lever"],
+        description="ablation: kc-rrtconnect whose free regions bound an offset body's "
+        "centre by the lever rule alone, without its arc (rigid robots; arms: as "
+        "kc-rrtconnect)",
+    ),
     "kc-rrtconnect-noparts": PlannerSpec(
         og.RRTConnect,
         _KC,

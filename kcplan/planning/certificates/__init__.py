@@ -21,7 +21,10 @@ name           rule                                    needs
                ``P_eps`` of the largest guard
                ``(1 + eps) a`` the clearance frees
 ``region``     separating planes of every obstacle     a region query
-               piece within a horizon
+               piece within a horizon; an offset
+               body's centre on its arc
+``region-      the same with the lever rule for        a region query
+lever``        offset bodies (the ablation)
 ============== ======================================= =================================
 """
 
@@ -31,5 +34,5 @@ from kcplan.planning.certificates.region import FreeRegionPlanes
 
 __all__ = ["CERTIFICATE_NAMES", "ClearanceBall", "KCPolytope", "FreeRegionPlanes"]
 
-CERTIFICATE_NAMES = ("ball", "rotation", "polytope", "region")
+CERTIFICATE_NAMES = ("ball", "rotation", "polytope", "region", "region-lever")
 """Names accepted by :class:`kcplan.planning.certifier.EdgeCertifier`."""
