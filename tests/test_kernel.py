@@ -339,6 +339,30 @@ def test_warm_started_queries_answer_as_cold_ones(name):
     assert 0 < hits < 240 and planes > 0  # both kinds of pose, and planes, were met
 
 
+@pytest.mark.parametrize("e, axes", [(0.3, [6, 3, 2]), (1.0, [4, 4, 1])])
+def test_region_planes_hold_the_full_scans_support(e, axes):
+    """A region plane's offset is the exact support of its piece along the plane's normal
+    (the plane holds the piece whatever the direction): for one superquadric polytope of
+    about 1,000 vertices it is, at every pose, the maximum of ``n . x`` over all its
+    vertices."""
+    vertices = bounding_polytopes(axes, e, count=500).outer
+    obstacles = [{"convex": {"vertices": vertices.tolist()}}]
+    data = _scenario_dict("one piece", 3, ([-25] * 3, [25] * 3), THREE_BODIES, obstacles)
+    scenario = parse_scenario(data, check=False)
+    world = CollisionWorld(scenario).kernel
+    rng = np.random.default_rng(len(vertices))
+    planes = 0
+    for _ in range(300):
+        pose = np.concatenate([rng.uniform(-16, 16, 3), random_pose(rng, 3, 0, 1)[3:]])
+        free, regions = world.free_regions(pose.tolist(), 30.0)
+        for rows, _horizon in regions if free else ():
+            for nx, ny, nz, offset, _clearance in rows:
+                scan = vertices[:, 0] * nx + vertices[:, 1] * ny + vertices[:, 2] * nz
+                assert offset == pytest.approx(scan.max(), rel=1e-14, abs=1e-13)
+                planes += 1
+    assert planes > 300
+
+
 def _arena_world(directory: Path) -> Scenario:
     """Three ellipsoids inside a convex arena mesh (an icosphere stretched to 40 x 24 x 16
     semi-axes, 1,280 triangles, as HRM's inscribed arenas), with a box, a ball and a

@@ -87,7 +87,8 @@ class FreeRegionPlanes final : public Certificate {
                                spin[0] * r[1] - spin[1] * r[0]};
       const double cx = dt[0] + swing[0], cy = dt[1] + swing[1], cz = dt[2] + swing[2];
       const double shape_turn = shape_levers_[k] * w;
-      const double bend = arc_ ? 0.5 * offsets_[k] * w * w : kInf;
+      // a body at the origin has no arc: the two rules are one (bend = inf: the lever's)
+      const double bend = arc_ && offsets_[k] > 0.0 ? 0.5 * offsets_[k] * w * w : kInf;
       const double arc_speed = std::sqrt(cx * cx + cy * cy + cz * cz) + shape_turn;
       // how long the body stays within distance d of where it is at m
       const auto within = [&](double d) {

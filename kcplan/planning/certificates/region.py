@@ -102,7 +102,8 @@ class FreeRegionPlanes:
             rx, ry, rz = body.arm
             cx, cy, cz = dx + oy * rz - oz * ry, dy + oz * rx - ox * rz, dz + ox * ry - oy * rx
             shape_turn = shape_lever * w
-            bend = 0.5 * offset * w * w if self.arc else math.inf
+            # a body at the origin has no arc: the two rules are one (bend = inf: the lever's)
+            bend = 0.5 * offset * w * w if self.arc and offset > 0.0 else math.inf
             arc_speed = math.sqrt(cx * cx + cy * cy + cz * cz) + shape_turn
 
             def within(d, speed=speed, arc_speed=arc_speed, bend=bend):
