@@ -41,6 +41,25 @@ def corridor_world(semi_axes=(5.0, 3.5)) -> CollisionWorld:
     return CollisionWorld(parse_scenario(data, check=False))
 
 
+def guarded_edge(rng, world, spread, keep):
+    """A random edge from a pose in [-18, 18] that ``keep(world, pose)`` accepts, turning
+    anywhere and moving about ``spread``, with a region guard (horizon 4) at a random
+    parameter ``m``: ``(edge, m, guard)``, or None (a start refused, or a guard in
+    contact)."""
+    n = world.robot.dimension
+    p1 = random_pose(rng, n, -18, 18)
+    if not keep(world, p1):
+        return None
+    p2 = p1.copy()
+    p2[:n] += rng.normal(0, spread, n)
+    p2[n:] = random_pose(rng, n, 0, 1)[n:]
+    edge = Edge(p1, p2, n)
+    m = float(rng.uniform(0, 1))
+    g = edge.pose(m)
+    guard = Guard.from_regions(g, world.free_regions(g, 4.0), world.robot, world.clearance_atol)
+    return None if guard.clearance <= 0.0 else (edge, m, guard)
+
+
 # ------------------------------------------------------------- rotation lever
 
 
@@ -131,20 +150,10 @@ def test_the_arc_rule_reaches_at_least_the_lever_rule_and_stays_free(n):
         arc, lever = FreeRegionPlanes(robot), FreeRegionPlanes(robot, arc=False)
         assert (arc.name, lever.name) == ("region", "region-lever")
         for _ in range(60):
-            p1 = random_pose(rng, n, -18, 18)
-            if world.in_collision(p1):
+            drawn = guarded_edge(rng, world, 3.0, lambda w, p: not w.in_collision(p))
+            if drawn is None:
                 continue
-            p2 = p1.copy()
-            p2[:n] += rng.normal(0, 3.0, n)
-            p2[n:] = random_pose(rng, n, 0, 1)[n:]
-            edge = Edge(p1, p2, n)
-            m = float(rng.uniform(0, 1))
-            g = edge.pose(m)
-            guard = Guard.from_regions(
-                g, world.free_regions(g, 4.0), world.robot, world.clearance_atol
-            )
-            if guard.clearance <= 0.0:
-                continue
+            edge, m, guard = drawn
             minus, plus = arc.reach(guard, edge, m)
             old_minus, old_plus = lever.reach(guard, edge, m)
             assert minus >= old_minus and plus >= old_plus
@@ -236,19 +245,10 @@ def test_reach_of_every_certificate_is_collision_free(n, certificate):
     for _ in range(6):
         world = CollisionWorld(random_scenario(rng, n, a, 8, half_width=20.0))
         for _ in range(80):
-            p1 = random_pose(rng, n, -18, 18)
-            if not 0.0 < world.clearance(p1) < 3.0:
+            drawn = guarded_edge(rng, world, 6.0, lambda w, p: 0.0 < w.clearance(p) < 3.0)
+            if drawn is None:
                 continue
-            p2 = p1.copy()
-            p2[:n] += rng.normal(0, 6.0, n)
-            p2[n:] = random_pose(rng, n, 0, 1)[n:]
-            edge = Edge(p1, p2, n)
-            m = float(rng.uniform(0, 1))
-            g = edge.pose(m)
-            regions = world.free_regions(g, 4.0)
-            guard = Guard.from_regions(g, regions, world.robot, world.clearance_atol)
-            if guard.clearance <= 0.0:
-                continue
+            edge, m, guard = drawn
             minus, plus = cert.reach(guard, edge, m)
             assert minus > 0 and plus > 0
             assert dense_free(world, edge, m - minus, m + plus)
