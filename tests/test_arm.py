@@ -297,18 +297,24 @@ UR5_GROUP = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_
 
 
 @pytest.mark.parametrize(
-    "urdf, group, bodies, pairs",
-    [(PANDA / "panda.urdf", GROUP, 287, 13184), (UR5 / "ur5.urdf", UR5_GROUP, 226, 14544)],
-    ids=["panda", "ur5"],
+    "urdf, group, per_link, bodies, pairs",
+    [
+        (PANDA / "panda.urdf", GROUP, None, 287, 13184),
+        (UR5 / "ur5.urdf", UR5_GROUP, None, 226, 14544),
+        (PANDA / "panda.urdf", GROUP, 4, 44, 336),
+    ],
+    ids=["panda", "ur5", "panda-4"],
 )
 def test_the_default_covers_come_checked_from_the_bundle(
-    urdf, group, bodies, pairs, tmp_path, monkeypatch
+    urdf, group, per_link, bodies, pairs, tmp_path, monkeypatch
 ):
     """Every machine plans MBM's robots with the same default cover (kcplan/cover/bundled),
-    and none is fitted: the benchmarks' body and pair counts, nothing written to the cache."""
+    and so the bundled scenarios' Panda (4 bodies a link), and none is fitted: the
+    benchmarks' body and pair counts, nothing written to the cache."""
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
     lines: list[str] = []
-    arm = load_arm(urdf, group, srdf=urdf.with_suffix(".srdf"), progress=lines.append)
+    srdf = urdf.with_suffix(".srdf")
+    arm = load_arm(urdf, group, srdf=srdf, bodies_per_link=per_link, progress=lines.append)
     assert (len(arm.bodies), len(arm.self_pairs)) == (bodies, pairs)
     assert lines and all(" bundled" in line and "fitted" not in line for line in lines)
     assert not list(tmp_path.iterdir())
