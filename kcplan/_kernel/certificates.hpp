@@ -100,15 +100,15 @@ class FreeRegionPlanes final : public Certificate {
         const double ball = within(p.clearance);
         if (p.slack > 0.0) {
           const double along = p.nx * dt[0] + p.ny * dt[1] + p.nz * dt[2];
-          const double towards = p.nx * cx + p.ny * cy + p.nz * cz;  // n . c'
+          const double away = p.nx * cx + p.ny * cy + p.nz * cz;  // n . c', off the piece
           double rate = turn - along;  // slack used up per unit s going forward
           const double ahead =
               std::max(rate > 0.0 ? p.slack / rate : kInf,
-                       arc_reach(p.slack, shape_turn - towards, bend));
+                       arc_reach(p.slack, shape_turn - away, bend));
           rate = turn + along;  // ... going backward
           const double behind =
               std::max(rate > 0.0 ? p.slack / rate : kInf,
-                       arc_reach(p.slack, shape_turn + towards, bend));
+                       arc_reach(p.slack, shape_turn + away, bend));
           plus = std::min(plus, std::max(ahead, ball));
           minus = std::min(minus, std::max(behind, ball));
         } else {

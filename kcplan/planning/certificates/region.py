@@ -41,7 +41,7 @@ f| <= |w|^2 |v|``, so by Taylor's theorem with the integral remainder
 The centre moves by ``c_k(s) - c_k(m) = x c' + e`` with the velocity ``c' = dt + w x v``
 and ``|e| <= b x^2``, ``b = |p_k| |w|^2 / 2``; the shape term is bounded as before. So
 
-    sigma_ik(s) >= sigma_ik - x (n_i . c') - |x| L0 |w| - b x^2,   L0 = a_max,k - a_min,k,
+    sigma_ik(s) >= sigma_ik + x (n_i . c') - |x| L0 |w| - b x^2,   L0 = a_max,k - a_min,k,
 
 and piece ``i`` stays on its side while ``b x^2 + r x < sigma_ik`` with ``r = L0 |w| -
 n_i . c'`` going forward (``L0 |w| + n_i . c'`` backward): up to the positive root
@@ -117,16 +117,16 @@ class FreeRegionPlanes:
                 ball = within(clearance)
                 if slack > 0.0:
                     along = nx * dx + ny * dy + nz * dz
-                    towards = nx * cx + ny * cy + nz * cz  # n . c'
+                    away = nx * cx + ny * cy + nz * cz  # n . c', off the piece
                     rate = turn - along  # slack used up per unit s going forward
                     ahead = max(
                         slack / rate if rate > 0.0 else math.inf,
-                        _arc_reach(slack, shape_turn - towards, bend),
+                        _arc_reach(slack, shape_turn - away, bend),
                     )
                     rate = turn + along  # ... going backward
                     behind = max(
                         slack / rate if rate > 0.0 else math.inf,
-                        _arc_reach(slack, shape_turn + towards, bend),
+                        _arc_reach(slack, shape_turn + away, bend),
                     )
                     plus = min(plus, max(ahead, ball))
                     minus = min(minus, max(behind, ball))
