@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pytest
 
+from kcplan.planning.certifier import CERTIFICATE_SETS
+
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ROOT / "scripts"
 HRM = ROOT.parent / "shared" / "data" / "external" / "hrm" / "resources"
@@ -55,7 +57,7 @@ def _same_suite(_out: str, tmp: Path) -> None:
 def _no_violation(out: str, _tmp: Path) -> None:
     rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 100 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
     assert {(n, name) for n, name, *_ in rows} == {
-        (n, name) for n in ("2D", "3D") for name in ("ca", "kc-paper", "kc")
+        (n, name) for n in ("2D", "3D") for name in CERTIFICATE_SETS
     }
     assert all(int(violations) == 0 for *_, violations, _ in rows), rows
 
