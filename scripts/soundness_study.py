@@ -9,7 +9,7 @@ robot poses reach or leave it: the kernel's mesh planes and coal's BVH both deci
 decided by the certifier (``--backend
 kernel``: the compiled :class:`kcplan.planning.kernel.KernelCertifier`, the default;
 ``python``: the Python :class:`kcplan.planning.certifier.EdgeCertifier`) with every
-certificate set of the ablation (``ca``, ``kc-paper``, ``kc``). Every accepted edge is
+certificate set of the ablation (``ca``, ``kc-paper``, ``kc``, ``kc-lever``). Every accepted edge is
 re-checked by gap-free conservative advancement with FCL clearances
 (:func:`kcplan.planning.verify.verify_path`, which shares no code with the certificates);
 a *violation* is an accepted edge that check finds in collision, and must be 0. A *free
