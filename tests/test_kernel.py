@@ -32,6 +32,9 @@ from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.planning.certifier import (
     CERTIFICATE_SETS,
     COUNTER_NAMES,
+    LEARN_EVERY,
+    LEARN_ODDS,
+    LEARN_WARMUP,
     PROBE_EVERY,
     PROBE_WARMUP,
     EdgeCertifier,
@@ -223,6 +226,8 @@ LOOSE_COUNTERS = (
     "probed_edges",
     "not_proven",
     "occupancy_queries",
+    "occupancy_rejections",
+    "rejected_occupancy",
     "certified_by_endpoints",
     "certified_one_guard",
     "guards",
@@ -235,9 +240,12 @@ different nearest points (so separating planes) and clearances, so a guard reach
 little further in one of them; near contact a guard has a tiny clearance in one and none
 in the other (``not_proven`` / ``rejected_guard``), and coal's collision test reports
 contact up to about 1e-6 before its distance reaches 0, so the kernel learns more grid
-cells from the near-contact states (``occupancy_queries``). A near-contact edge may be
-rejected by a probe in one and by a guard in the other, and the probes' schedule follows
-the rejections (``rejected_probe``, ``probes``, ``probed_edges``)."""
+cells from the near-contact states (``occupancy_queries``); the grid's learning
+schedule follows the grid's rejections, so the twins learn a few other cells
+(``occupancy_rejections``, ``rejected_occupancy``; the decisions stay the same). A
+near-contact edge may be rejected by a probe in one and by a guard in the other, and the
+probes' schedule follows the rejections (``rejected_probe``, ``probes``,
+``probed_edges``)."""
 
 
 def _counter_gap(python: dict, kernel: dict) -> dict:
@@ -752,6 +760,40 @@ def test_probes_stop_where_they_do_not_reject():
         assert c["cached_guards"] == 0 and c["rejected"] == 0
         assert c["probed_edges"] == PROBE_WARMUP + (c["edges"] - PROBE_WARMUP) // PROBE_EVERY
     assert kernel == python
+
+
+def test_grid_cells_are_learned_while_they_pay():
+    """The occupancy grid's schedule (LEARN_WARMUP, LEARN_ODDS, LEARN_EVERY): where the
+    colliding states hardly ever fall into a tested cell again, the grid tests the cell
+    of the first LEARN_WARMUP colliding states and then of every LEARN_EVERY-th; where
+    they come back to the same cells, the cell of every one. Both twins keep the same
+    schedule; ``learn_schedule=False`` tests every cell."""
+    data = _scenario_dict(
+        "floor", 2, ([0.0, 0.0], [400.0, 200.0]), {"semi_axes": [2.0, 1.0]},
+        [{"box": {"center": [200.0, 50.0], "size": [400.0, 100.0]}}],
+    )  # fmt: skip
+    world = CollisionWorld(parse_scenario(data, check=False))
+    rng = np.random.default_rng(6)
+    spread = [[*rng.uniform([5, 5], [395, 95]), 0.0] for _ in range(2000)]  # all collide
+    counters = {}
+    for backend, cls in (("kernel", KernelCertifier), ("python", EdgeCertifier)):
+        for schedule in (True, False):
+            certifier = cls(world, learn_schedule=schedule)
+            assert not any(certifier.state_valid(p) for p in spread)
+            counters[backend, schedule] = certifier.counters
+    assert counters["kernel", True] == counters["python", True]
+    assert counters["kernel", False] == counters["python", False]
+    paid, every = counters["kernel", True], counters["kernel", False]
+    assert every["occupancy_rejections"] * LEARN_ODDS < every["occupancy_queries"]
+    assert every["occupancy_queries"] > 1900  # a cell tested for nearly every state
+    assert LEARN_WARMUP + 1700 // LEARN_EVERY < paid["occupancy_queries"]
+    assert paid["occupancy_queries"] <= LEARN_WARMUP + 1750 // LEARN_EVERY
+    # states that come back to a few cells: the grid pays, every cell is tested
+    back = [[*rng.uniform([5, 5], [25, 25]), 0.0] for _ in range(2000)]
+    certifier = KernelCertifier(world)
+    assert not any(certifier.state_valid(p) for p in back)
+    c = certifier.counters
+    assert c["occupancy_rejections"] * LEARN_ODDS >= c["occupancy_queries"] > 100
 
 
 def test_probe_points_halve_the_largest_stretch_left():

@@ -189,11 +189,11 @@ NB_MODULE(_core, m) {
              double horizon, bool sweep_test, bool occupancy, int probes, std::array<double, 3> low,
              std::array<double, 3> high, std::size_t cache_entries,
              const std::vector<double>& levels, const std::vector<std::vector<double>>& rows,
-             double scale) {
+             double scale, bool learn_schedule) {
             kcplan::CertifierOptions o;
             o.certificates = certificates, o.discrete = discrete, o.max_guards = max_guards;
             o.horizon = horizon, o.sweep_test = sweep_test, o.occupancy = occupancy;
-            o.probes = probes;
+            o.probes = probes, o.learn_schedule = learn_schedule;
             o.low = low, o.high = high, o.cache_entries = cache_entries;
             std::unique_ptr<kcplan::KCPolytope> polytope;
             if (!levels.empty())
@@ -203,7 +203,8 @@ NB_MODULE(_core, m) {
           },
           "world"_a, "certificates"_a, "discrete"_a, "max_guards"_a, "horizon"_a,
           "sweep_test"_a, "occupancy"_a, "probes"_a, "low"_a, "high"_a, "cache_entries"_a,
-          "ladder_levels"_a, "ladder_rows"_a, "ladder_scale"_a, nb::keep_alive<1, 2>())
+          "ladder_levels"_a, "ladder_rows"_a, "ladder_scale"_a, "learn_schedule"_a = true,
+          nb::keep_alive<1, 2>())
       .def("check",
            [](kcplan::EdgeCertifier& c, const std::vector<double>& p1,
               const std::vector<double>& p2, double resolution) {
@@ -262,6 +263,7 @@ NB_MODULE(_core, m) {
       .def_prop_ro("sweep_test", &kcplan::EdgeCertifier::sweep_test)
       .def_prop_ro("occupancy", &kcplan::EdgeCertifier::occupancy)
       .def_prop_ro("probes", &kcplan::EdgeCertifier::probes)
+      .def_prop_ro("learn_schedule", &kcplan::EdgeCertifier::learn_schedule)
       .def_prop_ro("discrete", &kcplan::EdgeCertifier::discrete);
 
   nb::class_<kcplan::Chain>(m, "Chain")

@@ -8,7 +8,8 @@ namespace kcplan {
 EdgeCertifier::EdgeCertifier(World& world, const CertifierOptions& options,
                              std::unique_ptr<KCPolytope> polytope)
     : world_(world), robot_(world.robot()), discrete_(options.discrete),
-      max_guards_(options.max_guards), probes_(options.probes), core_radius_(world.robot().core_radius()),
+      max_guards_(options.max_guards), probes_(options.probes),
+      learn_schedule_(options.learn_schedule), core_radius_(world.robot().core_radius()),
       domain_(world.robot().dimension(), options.low, options.high, world.robot().reach()),
       cache_(options.cache_entries) {
   if (options.certificates.empty())
@@ -69,7 +70,7 @@ bool EdgeCertifier::state_valid(const Pose& pose) {
 bool EdgeCertifier::collision_free(const Pose& p, const GuardCache::Key& key) {
   ++counters.collision_queries;
   const bool valid = !world_.in_collision(p);
-  if (!valid && grid_) {  // learn the cell for the next state there
+  if (!valid && grid_ && learning()) {  // learn the cell for the next state there
     const std::int64_t before = grid_->queries;
     grid_->learn(p.t);
     counters.occupancy_queries += grid_->queries - before;
@@ -173,6 +174,17 @@ bool EdgeCertifier::probing() {
   if (c.probed_edges < kProbeWarmup || c.rejected_probe * kProbeOdds >= c.probed_edges)
     return true;
   return ++probe_skips_ % kProbeEvery == 0;
+}
+
+bool EdgeCertifier::learning() {
+  // a cell costs a ball query to test and saves a collision query each time it rejects
+  // (a ball query costs about half of one): test cells while they pay
+  if (!learn_schedule_) return true;
+  const CertifierCounters& c = counters;
+  const std::int64_t rejections = c.occupancy_rejections + c.rejected_occupancy;
+  if (c.occupancy_queries < kLearnWarmup || rejections * kLearnOdds >= c.occupancy_queries)
+    return true;
+  return ++learn_skips_ % kLearnEvery == 0;
 }
 
 bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {

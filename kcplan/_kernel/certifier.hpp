@@ -26,6 +26,12 @@ namespace kcplan {
 /// kProbeEvery-th edge, so that the rate stays measured.
 constexpr std::int64_t kProbeWarmup = 64, kProbeOdds = 5, kProbeEvery = 16;
 
+/// The occupancy grid's learning schedule (kcplan/planning/certifier.py: LEARN_WARMUP,
+/// LEARN_ODDS, LEARN_EVERY): the cell of every colliding state is tested while fewer than
+/// kLearnWarmup cells were, or while the grid rejects at least one state or edge per
+/// kLearnOdds tested cells; otherwise at every kLearnEvery-th colliding state.
+constexpr std::int64_t kLearnWarmup = 256, kLearnOdds = 2, kLearnEvery = 8;
+
 /// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
 struct CertifierCounters {
   std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
@@ -57,6 +63,7 @@ struct CertifierOptions {
   bool sweep_test = true;    ///< the core-capsule rejection (needs a core)
   bool occupancy = true;     ///< the occupancy grid (needs a core)
   int probes = 3;            ///< collision queries at bisection points before any guard
+  bool learn_schedule = true;  ///< the grid learns cells on its schedule (false: always)
   /// Bounds of the robot's origin: the occupancy grid's box, and the domain of poses
   /// decided (PoseDomain pads them by their diagonal and the robot's reach).
   std::array<double, 3> low{0, 0, 0}, high{0, 0, 0};
@@ -102,6 +109,7 @@ class EdgeCertifier {
   double margin() const { return margin_; }
   bool sweep_test() const { return sweep_test_; }
   bool occupancy() const { return grid_.has_value(); }
+  bool learn_schedule() const { return learn_schedule_; }
   int probes() const { return probes_; }
   bool discrete() const { return discrete_; }
   World& world() { return world_; }
@@ -114,6 +122,7 @@ class EdgeCertifier {
              double& hi);
   bool reject(std::int64_t& reason);
   bool probing();
+  bool learning();
   bool probe(const Edge& edge, double lo, double hi);
   bool advance(const Edge& edge, double lo, double hi);
   bool sample(const Edge& edge, double resolution, double lo, double hi);
@@ -124,7 +133,8 @@ class EdgeCertifier {
   std::vector<double> covered_;
   bool use_region_ = false, discrete_ = false, sweep_test_ = false;
   int max_guards_, probes_;
-  std::int64_t probe_skips_ = 0;
+  bool learn_schedule_;
+  std::int64_t probe_skips_ = 0, learn_skips_ = 0;
   double horizon_, margin_, core_radius_;
   PoseDomain domain_;
   GuardCache cache_;

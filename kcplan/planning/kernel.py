@@ -37,6 +37,8 @@ class KernelCertifier:
         ``occupancy`` default to on; both need a robot core).
     cache_entries : int
         Bound of the guard cache (guards, and as many validity marks).
+    learn_schedule : bool
+        As for :class:`~kcplan.planning.certifier.EdgeCertifier`.
 
     Notes
     -----
@@ -57,6 +59,7 @@ class KernelCertifier:
         occupancy: bool | None = None,
         cache_entries: int = 200_000,
         probes: int = DEFAULT_PROBES,
+        learn_schedule: bool = True,
     ):
         robot = world.robot
         certificates = tuple(CERTIFICATE_SETS["kc"] if certificates is None else certificates)
@@ -88,12 +91,14 @@ class KernelCertifier:
             levels,
             rows,
             float(scale),
+            bool(learn_schedule),
         )
         self.horizon = self._kernel.horizon
         self.margin = self._kernel.margin
         self.sweep_test = self._kernel.sweep_test
         self.occupancy = self._kernel.occupancy
         self.probes = self._kernel.probes
+        self.learn_schedule = self._kernel.learn_schedule
         # the validator's hot path calls these directly (one Python call per edge)
         self.check_se2, self.check_se3 = self._kernel.check_se2, self._kernel.check_se3
         self.state_valid_se2 = self._kernel.state_valid_se2

@@ -57,6 +57,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",
     "kc-rrtconnect-lever",
+    "kc-rrtconnect-learnall",
     "kc-rrtconnect-noparts",
     "kc-rrtconnect-nofirst",
     "kc-prm-noprobe",

@@ -74,6 +74,7 @@ class PlannerSpec:
     joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
     part_balls: bool = True  # arms (kc, kernel): far groups of self pairs decided at once
     first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
+    learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
 
     @property
     def kc(self) -> bool:
@@ -127,6 +128,13 @@ PLANNERS: dict[str, PlannerSpec] = {
         description="ablation: kc-rrtconnect whose free regions bound an offset body's "
         "centre by the lever rule alone, without its arc (rigid robots; arms: as "
         "kc-rrtconnect)",
+    ),
+    "kc-rrtconnect-learnall": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation: kc-rrtconnect whose occupancy grid tests the cell of every "
+        "colliding state, not only while it pays (rigid robots; arms: as kc-rrtconnect)",
+        learn_schedule=False,
     ),
     "kc-rrtconnect-noparts": PlannerSpec(
         og.RRTConnect,
@@ -533,6 +541,7 @@ def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | 
             spec.fallback,
             backend=spec.backend,
             probes=spec.probes,
+            learn_schedule=spec.learn_schedule,
         )
         si.setMotionValidator(validator)
         state_valid = validator.state_valid  # shares the validator's guard cache

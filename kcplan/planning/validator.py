@@ -94,6 +94,9 @@ class KCMotionValidator(ob.MotionValidator):
         Collision queries at bisection points of an edge before its guards, so that a
         colliding edge is rejected at a collision query's price (default
         :data:`kcplan.planning.certifier.DEFAULT_PROBES`; 0: none).
+    learn_schedule : bool
+        Rigid robots: test the occupancy grid's cells only while the grid pays
+        (:data:`kcplan.planning.certifier.LEARN_ODDS`); False: at every colliding state.
     backend : {"kernel", "python"}, optional
         Who decides: the compiled kernel (:class:`kcplan.planning.kernel.KernelCertifier`,
         on coal; the default for a :class:`kcplan.CollisionWorld`, whose robot it
@@ -125,6 +128,7 @@ class KCMotionValidator(ob.MotionValidator):
         probes: int = DEFAULT_PROBES,
         part_balls: bool = True,
         first_order: bool = True,
+        learn_schedule: bool = True,
     ):
         super().__init__(si)
         self.space = si.getStateSpace()  # not si itself: see the module docstring
@@ -155,12 +159,12 @@ class KCMotionValidator(ob.MotionValidator):
                 raise ValueError("robot: the kernel certifies the world's own robot; got another")
             self.certifier = KernelCertifier(
                 world, certificates, ladder, horizon, fallback, max_guards, sweep_test,
-                probes=probes,
+                probes=probes, learn_schedule=learn_schedule,
             )  # fmt: skip
         else:
             self.certifier = EdgeCertifier(
                 world, robot, certificates, ladder, horizon, fallback, max_guards, sweep_test,
-                probes=probes,
+                probes=probes, learn_schedule=learn_schedule,
             )  # fmt: skip
         self.backend = backend
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
