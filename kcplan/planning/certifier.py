@@ -87,7 +87,7 @@ LEARN_WARMUP, LEARN_ODDS, LEARN_EVERY = 256, 2, 8
 at least one state or edge per ``LEARN_ODDS`` tested cells; otherwise at every
 ``LEARN_EVERY``-th colliding state. A ball query costs about half a collision query of
 the robot, and a blocked cell saves one each time it rejects: on HRM's maze the grid
-rejects about 0.66 per tested cell, on its cluttered map 0.19 (RESULTS 12)."""
+rejects about 0.66 per tested cell, on its cluttered map 0.19 (RESULTS 12.1)."""
 
 
 class EdgeCertifier:
