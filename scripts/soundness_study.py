@@ -5,7 +5,10 @@ Random worlds of thin rotated walls, balls, boxes and ellipsoids
 random edges from a free state closer to an obstacle than the robot's size (short, medium
 and long, with and without rotation); with ``--arena`` each 3D world is also enclosed in a
 convex mesh (a stretched icosphere of 1,280 triangles, semi-axes 26 to 34, so that some
-robot poses reach or leave it: the kernel's mesh planes and coal's BVH both decide), each
+robot poses reach or leave it: the kernel's mesh planes and coal's BVH both decide); with
+``--bodies K`` each world gets a robot of K ellipses/ellipsoids offset up to 3 from its
+origin (:func:`kcplan.world.clutter.random_robot`: long levers, the region certificate's
+arc rule; the paper's polytope, for one body at the origin, is left out), each
 decided by the certifier (``--backend
 kernel``: the compiled :class:`kcplan.planning.kernel.KernelCertifier`, the default;
 ``python``: the Python :class:`kcplan.planning.certifier.EdgeCertifier`) with every
@@ -17,7 +20,7 @@ edge rejected* is a rejected edge the check finds free (the price of proving). P
 Markdown table::
 
     python scripts/soundness_study.py [--edges 100000] [--seed 1] [--dimensions 2 3] \
-        [--backend kernel] [--arena]
+        [--backend kernel] [--arena] [--bodies K]
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
 from kcplan.world import CollisionWorld, Scenario
-from kcplan.world.clutter import random_pose, random_scenario
+from kcplan.world.clutter import random_pose, random_robot, random_scenario
 from kcplan.world.scenario import Obstacle
 
 SHAPES = {
@@ -43,11 +46,11 @@ SHAPES = {
 }
 
 
-def certifier(backend: str, world, a, kinds, ladder):
-    """The edge certifier of ``backend`` for ``world``'s robot (semi-axes ``a``)."""
+def certifier(backend: str, world, kinds, ladder):
+    """The edge certifier of ``backend`` for ``world``'s robot."""
     if backend == "kernel":
         return KernelCertifier(world, certificates=kinds, ladder=ladder)
-    return EdgeCertifier(world, a, kinds, ladder)
+    return EdgeCertifier(world, world.robot, kinds, ladder)
 
 
 def with_arena(scenario: Scenario, rng: np.random.Generator) -> Scenario:
@@ -62,26 +65,39 @@ def with_arena(scenario: Scenario, rng: np.random.Generator) -> Scenario:
 
 
 def study(
-    n: int, edges: int, rng: np.random.Generator, backend: str = "kernel", arena: bool = False
+    n: int,
+    edges: int,
+    rng: np.random.Generator,
+    backend: str = "kernel",
+    arena: bool = False,
+    bodies: int = 1,
 ) -> dict:
-    """Counts per certificate set for ``edges`` random edges in ``n`` dimensions."""
-    counts = {
-        name: dict.fromkeys(("accepted", "violations", "free_rejected"), 0)
-        for name in CERTIFICATE_SETS
+    """Counts per certificate set for ``edges`` random edges in ``n`` dimensions, with
+    one body at the origin (:data:`SHAPES`) or ``bodies`` offset ones."""
+    sets = {
+        name: kinds
+        for name, kinds in CERTIFICATE_SETS.items()
+        if bodies == 1 or "polytope" not in kinds
     }
+    counts = {name: dict.fromkeys(("accepted", "violations", "free_rejected"), 0) for name in sets}
     done = 0
     while done < edges:
-        a = SHAPES[n][int(rng.integers(len(SHAPES[n])))]
-        scenario = random_scenario(rng, n, a, int(rng.integers(6, 16)))
+        if bodies == 1:
+            robot = SHAPES[n][int(rng.integers(len(SHAPES[n])))]
+        else:
+            robot = random_robot(rng, n, bodies)
+        scenario = random_scenario(rng, n, robot, int(rng.integers(6, 16)))
         world = CollisionWorld(with_arena(scenario, rng) if arena and n == 3 else scenario)
-        ladder = GuardLadder(a)
+        size = world.robot.largest_semi_axis
         certifiers = {
-            name: certifier(backend, world, a, kinds, ladder if "polytope" in kinds else None)
-            for name, kinds in CERTIFICATE_SETS.items()
+            name: certifier(
+                backend, world, kinds, GuardLadder(robot) if "polytope" in kinds else None
+            )
+            for name, kinds in sets.items()
         }
         for _ in range(200):
             p1 = random_pose(rng, n, -22, 22)
-            if not 0.0 < world.clearance(p1) < max(a):  # free, and near an obstacle
+            if not 0.0 < world.clearance(p1) < size:  # free, and near an obstacle
                 continue
             p2 = p1.copy()
             p2[:n] += rng.normal(0, rng.choice([0.5, 3.0, 15.0]), n)
@@ -112,13 +128,18 @@ def main() -> None:
         help="who certifies: the compiled kernel (default) or the Python certifier",
     )
     parser.add_argument("--arena", action="store_true", help="enclose each 3D world in a mesh")
+    parser.add_argument(
+        "--bodies", type=int, default=1, help="bodies per robot (> 1: offset from its origin)"
+    )
     args = parser.parse_args()
+    if args.bodies < 1:
+        parser.error("--bodies: expected a number >= 1")
     rng = np.random.default_rng(args.seed)
     print("| dimension | certificates | edges | accepted | violations | free edges rejected |")
     print("|---|---|---|---|---|---|")
     for n in args.dimensions:
         t0 = time.perf_counter()
-        counts = study(n, args.edges, rng, args.backend, args.arena)
+        counts = study(n, args.edges, rng, args.backend, args.arena, args.bodies)
         for name, c in counts.items():
             print(
                 f"| {n}D | {name} | {args.edges} | {c['accepted']} | {c['violations']} "
