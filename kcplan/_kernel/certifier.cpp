@@ -169,22 +169,15 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
 bool EdgeCertifier::probing() {
   // a probe costs a collision query on every edge it does not reject; it pays where
   // edges that reach the guards are often rejected (a guard costs several queries)
-  if (probes_ == 0) return false;
-  const CertifierCounters& c = counters;
-  if (c.probed_edges < kProbeWarmup || c.rejected_probe * kProbeOdds >= c.probed_edges)
-    return true;
-  return ++probe_skips_ % kProbeEvery == 0;
+  return probes_ > 0 && probe_pace_.ask(counters.probed_edges, counters.rejected_probe);
 }
 
 bool EdgeCertifier::learning() {
   // a cell costs a ball query to test and saves a collision query each time it rejects
   // (a ball query costs about half of one): test cells while they pay
-  if (!learn_schedule_) return true;
   const CertifierCounters& c = counters;
-  const std::int64_t rejections = c.occupancy_rejections + c.rejected_occupancy;
-  if (c.occupancy_queries < kLearnWarmup || rejections * kLearnOdds >= c.occupancy_queries)
-    return true;
-  return ++learn_skips_ % kLearnEvery == 0;
+  return !learn_schedule_ ||
+         learn_pace_.ask(c.occupancy_queries, c.occupancy_rejections + c.rejected_occupancy);
 }
 
 bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {

@@ -32,6 +32,23 @@ constexpr std::int64_t kProbeWarmup = 64, kProbeOdds = 5, kProbeEvery = 16;
 /// kLearnOdds tested cells; otherwise at every kLearnEvery-th colliding state.
 constexpr std::int64_t kLearnWarmup = 256, kLearnOdds = 2, kLearnEvery = 8;
 
+/// A piece of work asked while it pays: on each of the first `warmup` tries, and while at
+/// least one try in `odds` paid off; otherwise on every `every`-th, so that the rate
+/// stays measured. Python twin: kcplan/planning/certifier.py, PayingSchedule.
+class PayingSchedule {
+ public:
+  PayingSchedule(std::int64_t warmup, std::int64_t odds, std::int64_t every)
+      : warmup_(warmup), odds_(odds), every_(every) {}
+  /// Whether to do the work now, after `tried` tries of which `paid` paid off.
+  bool ask(std::int64_t tried, std::int64_t paid) {
+    if (tried < warmup_ || paid * odds_ >= tried) return true;
+    return ++skips_ % every_ == 0;
+  }
+
+ private:
+  std::int64_t warmup_, odds_, every_, skips_ = 0;
+};
+
 /// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
 struct CertifierCounters {
   std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
@@ -134,7 +151,8 @@ class EdgeCertifier {
   bool use_region_ = false, discrete_ = false, sweep_test_ = false;
   int max_guards_, probes_;
   bool learn_schedule_;
-  std::int64_t probe_skips_ = 0, learn_skips_ = 0;
+  PayingSchedule probe_pace_{kProbeWarmup, kProbeOdds, kProbeEvery};
+  PayingSchedule learn_pace_{kLearnWarmup, kLearnOdds, kLearnEvery};
   double horizon_, margin_, core_radius_;
   PoseDomain domain_;
   GuardCache cache_;

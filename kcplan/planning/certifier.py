@@ -90,6 +90,23 @@ the robot, and a blocked cell saves one each time it rejects: on HRM's maze the 
 rejects about 0.66 per tested cell, on its cluttered map 0.19 (RESULTS 12.1)."""
 
 
+class PayingSchedule:
+    """A piece of work asked while it pays: on each of the first ``warmup`` tries, and
+    while at least one try in ``odds`` paid off; otherwise on every ``every``-th, so that
+    the rate stays measured (C++ twin: ``PayingSchedule`` in ``certifier.hpp``)."""
+
+    def __init__(self, warmup: int, odds: int, every: int):
+        self.warmup, self.odds, self.every = warmup, odds, every
+        self._skips = 0
+
+    def ask(self, tried: int, paid: int) -> bool:
+        """Whether to do the work now, after ``tried`` tries of which ``paid`` paid off."""
+        if tried < self.warmup or paid * self.odds >= tried:
+            return True
+        self._skips += 1
+        return self._skips % self.every == 0
+
+
 class EdgeCertifier:
     """Prove edges collision-free with guards and certificates, or reject them.
 
@@ -229,9 +246,9 @@ class EdgeCertifier:
         if not (isinstance(probes, int) and probes >= 0):
             raise ValueError(f"probes: expected a number >= 0, got {probes!r}")
         self.probes = probes
-        self._probe_skips = 0
+        self._probe_pace = PayingSchedule(PROBE_WARMUP, PROBE_ODDS, PROBE_EVERY)
         self.learn_schedule = bool(learn_schedule)
-        self._learn_skips = 0
+        self._learn_pace = PayingSchedule(LEARN_WARMUP, LEARN_ODDS, LEARN_EVERY)
         self.sweep_test = bool(sweep_test)
         self.cache = cache if cache is not None else GuardCache()
         self.occupancy = occupancy
@@ -301,15 +318,9 @@ class EdgeCertifier:
     def _learning(self) -> bool:
         """Whether a colliding state's grid cell is tested (:data:`LEARN_ODDS`): a cell
         costs a ball query to test and saves a collision query each time it rejects."""
-        if not self.learn_schedule:
-            return True
         c = self.counters
-        tested = c["occupancy_queries"]
         rejections = c["occupancy_rejections"] + c["rejected_occupancy"]
-        if tested < LEARN_WARMUP or rejections * LEARN_ODDS >= tested:
-            return True
-        self._learn_skips += 1
-        return self._learn_skips % LEARN_EVERY == 0
+        return not self.learn_schedule or self._learn_pace.ask(c["occupancy_queries"], rejections)
 
     def _endpoint(self, pose: np.ndarray, key: bytes) -> Guard:
         guard = self.cache.guard(key)
@@ -409,13 +420,8 @@ class EdgeCertifier:
 
     def _probing(self) -> bool:
         """Whether this edge is probed (the schedule of :data:`PROBE_WARMUP`)."""
-        if self.probes == 0:
-            return False
         probed, rejected = self.counters["probed_edges"], self.counters["rejected_probe"]
-        if probed < PROBE_WARMUP or rejected * PROBE_ODDS >= probed:
-            return True
-        self._probe_skips += 1
-        return self._probe_skips % PROBE_EVERY == 0
+        return self.probes > 0 and self._probe_pace.ask(probed, rejected)
 
     def _probe(self, edge: Edge, lo: float, hi: float) -> bool:
         """False when one of the probes of ``[lo, hi]`` collides."""

@@ -84,7 +84,7 @@ class FreeRegionPlanes:
         self.name = "region" if self.arc else "region-lever"
         self.levers = robot.levers
         self.offsets = [b.offset for b in robot.bodies]
-        self.shape_levers = [b.lever - b.offset for b in robot.bodies]
+        self.shape_levers = [float(b.semi_axes.max() - b.semi_axes.min()) for b in robot.bodies]
 
     def reach(self, guard: Guard, edge: Edge, m: float) -> tuple[float, float]:
         minus = plus = math.inf
@@ -105,16 +105,11 @@ class FreeRegionPlanes:
             # a body at the origin has no arc: the two rules are one (bend = inf: the lever's)
             bend = 0.5 * offset * w * w if self.arc and offset > 0.0 else math.inf
             arc_speed = math.sqrt(cx * cx + cy * cy + cz * cz) + shape_turn
-
-            def within(d, speed=speed, arc_speed=arc_speed, bend=bend):
-                # how long the body stays within distance d of where it is at m
-                return max(d / speed, _arc_reach(d, arc_speed, bend))
-
-            reach = within(body.horizon)
+            reach = _within(body.horizon, speed, arc_speed, bend)
             plus, minus = min(plus, reach), min(minus, reach)
             # a handful of pieces: plain floats beat numpy's per-call cost
             for nx, ny, nz, slack, clearance in body.planes:
-                ball = within(clearance)
+                ball = _within(clearance, speed, arc_speed, bend)
                 if slack > 0.0:
                     along = nx * dx + ny * dy + nz * dz
                     away = nx * cx + ny * cy + nz * cz  # n . c', off the piece
@@ -133,6 +128,12 @@ class FreeRegionPlanes:
                 else:
                     plus, minus = min(plus, ball), min(minus, ball)
         return minus, plus
+
+
+def _within(d: float, speed: float, arc_speed: float, bend: float) -> float:
+    """How long the body stays within distance ``d`` of where it is at ``m``: the longer
+    of the lever rule's and the arc rule's reach."""
+    return max(d / speed, _arc_reach(d, arc_speed, bend))
 
 
 def _arc_reach(budget: float, rate: float, bend: float) -> float:
