@@ -5,8 +5,8 @@ For the first ``--per-class`` problems of each class of a robot's ``problems.tar
 
 1. each problem becomes an arm scenario, as ``kcplan import mbm`` writes it
    (:func:`kcplan.arm.mbm.mbm_scenario`), in ``DIR/scenarios/CLASS_INDEX.yaml``, with the
-   cover chosen here (default: kcplan's default, cut until it sticks out of each link's
-   mesh by at most :data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`); a problem whose start
+   representation chosen here (default: kcplan's, each link its own convex hull; or an
+   ellipsoid cover, ``--bodies-per-link``, ``--max-offset``); a problem whose start
    or goal the cover touches (valid on the meshes, but not for the covered arm) is
    counted as *invalid for the cover* and not planned: no planner on that cover can
    solve it;
@@ -26,8 +26,8 @@ the meshes; VAMP's columns are over all the class's problems, its time VAMP's ow
 planning time in milliseconds::
 
     python scripts/mbm_bench.py [--robot panda|ur5] [--per-class 20] [--classes box,cage]
-        [--planners kc-rrtconnect,rrtconnect,...] [--time 10] [--bodies-per-link K]
-        [--max-offset D] [--vamp-python PY] [-o DIR]
+        [--planners kc-rrtconnect,rrtconnect,...] [--time 10] [--representation R]
+        [--bodies-per-link K] [--max-offset D] [--vamp-python PY] [-o DIR]
 
 A shared, loaded machine makes the times indicative; the counts are what they are.
 """
@@ -78,7 +78,7 @@ def write_scenarios(args: argparse.Namespace, folder: Path) -> dict[str, list]:
             name = f"{problem_class}_{index}"
             path = folder / f"{name}.yaml"
             data = mbm_scenario(problem, name, urdf, srdf, path, args.bodies_per_link,
-                                max_offset=args.max_offset)  # fmt: skip
+                                args.max_offset, args.representation)  # fmt: skip
             key = yaml.safe_dump(data["robot"], sort_keys=True)
             if key not in arms:  # one cover per robot description (fixed joints included)
                 arms[key] = parse_scenario(data, os.fspath(path), folder, check=False).arm
@@ -165,6 +165,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--planners", default=PLANNERS, help=f"default {PLANNERS}")
     parser.add_argument("--time", type=float, default=10.0, help="seconds per solve")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument(
+        "--representation",
+        choices=("hulls", "ellipsoids"),
+        default=None,
+        help="the links' bodies (default: kcplan's, hulls)",
+    )
     parser.add_argument("--bodies-per-link", type=int, default=None,
                         help="the cover: exactly K bodies per link (or, with --max-offset, "
                         "at most K)")  # fmt: skip

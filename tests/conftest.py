@@ -62,9 +62,10 @@ PANDA = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "panda"
 PANDA_GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 
 
-def panda_arm(bodies_per_link: int):
+def panda_arm(bodies_per_link: int | None):
     """The bundled Panda's 7-joint group, ``bodies_per_link`` ellipsoids per link, fitted
-    in the tests' private cover cache (once per test session and count)."""
+    in the tests' private cover cache (once per test session and count); None: each link
+    its own convex hull (kcplan's default representation)."""
     from kcplan.arm import load_arm
 
     return load_arm(
@@ -76,8 +77,15 @@ def panda_arm(bodies_per_link: int):
 @pytest.fixture(scope="module")
 def panda(request):
     """The bundled Panda for an arm test module: its ``BODIES_PER_LINK`` (default 2)
-    ellipsoids per link (:func:`panda_arm`)."""
+    ellipsoids per link, or its links' hulls where the module sets it to None
+    (:func:`panda_arm`)."""
     return panda_arm(getattr(request.module, "BODIES_PER_LINK", 2))
+
+
+@pytest.fixture(scope="module")
+def states(panda):
+    """300 random joint vectors of ``panda`` within its limits (seed 7)."""
+    return np.random.default_rng(7).uniform(panda.lower, panda.upper, size=(300, panda.dof))
 
 
 @pytest.fixture(scope="module")

@@ -18,17 +18,22 @@ GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 READY = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
 
 
+def _robot() -> dict:
+    """The bundled Panda, one ellipsoid per link."""
+    panda = ARM / "panda"
+    return {
+        "urdf": str(panda / "panda.urdf"),
+        "srdf": str(panda / "panda.srdf"),
+        "joints": GROUP,
+        "bodies_per_link": 1,
+    }
+
+
 def _scenario(tmp_path, **changes) -> Path:
     """A one-body-per-link Panda scenario (the bundled robot), with ``changes``."""
-    panda = ARM / "panda"
     data = {
         "name": "reach",
-        "robot": {
-            "urdf": str(panda / "panda.urdf"),
-            "srdf": str(panda / "panda.srdf"),
-            "joints": GROUP,
-            "bodies_per_link": 1,
-        },
+        "robot": _robot(),
         "start": {"joints": READY},
         "goal": {"joints": [1.64, -0.18, -2.46, -0.78, 1.21, 1.28, 1.13]},
         "obstacles": [
@@ -104,7 +109,16 @@ def test_a_start_that_the_cover_makes_collide_is_refused(scenario_file, capsys):
     bent = [0.0, -0.3, 0.0, -1.6, 0.0, 2.2, 0.785]  # link5's body meets the hand's
     path = scenario_file(start={"joints": bent})
     assert main(["plan", str(path)]) == 2
-    assert "start: the arm's cover touches an obstacle or itself" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "start: the arm's cover touches an obstacle or itself, its meshes do not" in err
+    assert "(robot.representation: hulls (the default) may free it)" in err
+    hulls = {key: value for key, value in _robot().items() if key != "bodies_per_link"}
+    load_scenario(scenario_file(start={"joints": bent}, robot=hulls))  # its hulls are free
+    dipped = [0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.785]  # the hand's mesh in the table
+    path = scenario_file(start={"joints": dipped}, robot=hulls)
+    assert main(["plan", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "start: the arm's links touch an obstacle or each other (on their own" in err
     allowed = scenario_file(
         start={"joints": bent},
         allowed=[["panda_link5", "panda_hand"], ["panda_link5", "panda_link7"]],
@@ -178,7 +192,7 @@ def test_import_mbm_writes_the_bundled_problem(tmp_path, capsys):
     ]
     assert main(argv) == 0
     printed = capsys.readouterr().out
-    assert "box_1, arm of 7 joints (44 bodies), 7 obstacles, 34 allowed" in printed
+    assert "box_1, arm of 7 joints (11 bodies), 7 obstacles, 34 allowed" in printed
     mine = yaml.safe_load(out.read_text())
     bundled = yaml.safe_load((ARM / "box_1.yaml").read_text())
     for key in ("start", "goal", "obstacles", "allowed"):
@@ -199,8 +213,8 @@ def test_import_mbm_writes_the_bundled_problem(tmp_path, capsys):
 
 def test_the_bundled_arm_scenarios_load_with_free_starts_and_goals():
     for path in sorted(ARM.glob("*.yaml")):
-        scenario = load_scenario(path)  # checks start and goal for the covered arm
-        assert scenario.arm.dof == 7 and len(scenario.arm.bodies) == 44
+        scenario = load_scenario(path)  # checks start and goal for the arm (its links' hulls)
+        assert scenario.arm.dof == 7 and len(scenario.arm.bodies) == 11
 
 
 def test_bench_runs_and_verifies_arm_planners(tmp_path, capsys):
@@ -224,4 +238,4 @@ def test_the_rigid_world_refuses_arms_with_one_line(capsys):
     with pytest.raises(TypeError, match="expected a rigid robot of ellipsoids, got an arm"):
         CollisionWorld(box)
     assert main(["validate", str(box)]) == 0
-    assert "robot arm of 7 joints, 44 bodies (panda.urdf)" in capsys.readouterr().out
+    assert "robot arm of 7 joints, 11 bodies (panda.urdf)" in capsys.readouterr().out

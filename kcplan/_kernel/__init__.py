@@ -158,7 +158,8 @@ def add_obstacles(world: _core.World, obstacles, n: int) -> None:
 def kernel_chain(arm) -> _core.Chain:
     """The kernel's twin of an :class:`kcplan.arm.ArmModel`'s chain and bodies: the
     reduced model's joint placements, axes and kinds (:func:`kcplan.arm.kinematics.
-    joint_axes`), each joint's place in the state, the limits and the covering bodies."""
+    joint_axes`), each joint's place in the state, the limits and the bodies (a hull's
+    vertices and triangles with it)."""
     from kcplan.arm.kinematics import joint_axes  # here: rigid users never load Pinocchio
 
     model = arm.model
@@ -177,6 +178,8 @@ def kernel_chain(arm) -> _core.Chain:
         [int(b.joint) for b in arm.bodies],
         [float(v) for b in arm.bodies for v in b.placement.ravel()],
         [float(v) for b in arm.bodies for v in b.semi_axes],
+        [[] if b.hull is None else b.hull.vertices.ravel().tolist() for b in arm.bodies],
+        [[] if b.hull is None else b.hull.triangles.ravel().tolist() for b in arm.bodies],
     )  # fmt: skip
 
 

@@ -83,6 +83,7 @@ void ArmCertifier::twist(const ArmGuard& guard) {
 template <class Frames>
 double ArmCertifier::kc_reach(const ArmGuard& guard, std::size_t k, Frames& frames) {
   const ChainBody& body = chain_.bodies()[k];
+  if (body.hull) return 0.0;  // KC's guard is an ellipsoid's: a hull has the ball alone
   const std::array<double, 3>& a = body.semi_axes;
   if (guard.grown[k] == 0) {
     if (guard.scene[k] > kc_ * body.a_max) {

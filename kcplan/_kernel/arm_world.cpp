@@ -91,9 +91,16 @@ ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pa
   frames_.resize(chain.bodies().size());
   framed_.assign(chain.bodies().size(), 0);
   placed_.assign(chain.bodies().size(), 0);
-  for (const ChainBody& b : chain.bodies())
-    shapes_.push_back(
-        std::make_shared<coal::Ellipsoid>(b.semi_axes[0], b.semi_axes[1], b.semi_axes[2]));
+  for (std::size_t k = 0; k < chain.bodies().size(); ++k) {
+    const ChainBody& b = chain.bodies()[k];
+    if (b.hull) {
+      shapes_.push_back(b.hull->shape());
+      scene_->set_body_shape(k, b.hull->shape());
+    } else {
+      shapes_.push_back(
+          std::make_shared<coal::Ellipsoid>(b.semi_axes[0], b.semi_axes[1], b.semi_axes[2]));
+    }
+  }
   guesses_.assign(pairs.size(), coal::Vec3s(1.0, 0.0, 0.0));
   hints_.assign(pairs.size(), coal::support_func_guess_t::Zero());
 }
@@ -158,10 +165,11 @@ void ArmWorld::scene_clearances(double* out, const double* caps) {
 
 namespace {
 
-/// |diag(a) R^T n|: the half width of the ellipsoid of semi-axes a, turned by R, along the
-/// unit n (its support function about its centre).
+/// How far the body at `frame` reaches from its centre along the unit n (its support
+/// function about its centre): a hull's largest n . v, an ellipsoid's |diag(a) R^T n|.
 double half_width(const ChainBody& body, const coal::Transform3s& frame, const coal::Vec3s& n) {
   const coal::Vec3s local = frame.getRotation().transpose() * n;
+  if (body.hull) return body.hull->support(local);
   const std::array<double, 3>& a = body.semi_axes;
   return std::sqrt(a[0] * a[0] * local[0] * local[0] + a[1] * a[1] * local[1] * local[1] +
                    a[2] * a[2] * local[2] * local[2]);
@@ -198,14 +206,14 @@ double ArmWorld::pair_gap(std::size_t m, const std::vector<coal::Transform3s>& f
   const ChainBody &a = chain_.bodies()[k], &b = chain_.bodies()[l];
   const coal::Vec3s between = frames[l].getTranslation() - frames[k].getTranslation();
   const double centres = between.norm();
-  // Along any unit n the two bodies are n . (c_l - c_k) - w_k(n) - w_l(n) apart at least
+  // Along any unit n the two bodies are n . (c_l - c_k) - w_k(n) - w_l(-n) apart at least
   // (their support functions, half_width); along the centres' line this is never below the
   // bounding balls' gap (w <= a_max), and it depends on the configuration alone (not on
   // the pair's last GJK direction: the same radii whatever was asked before)
   double gap = centres - a.a_max - b.a_max;
   if (centres > 0.0) {
     const coal::Vec3s n = between / centres;
-    gap = std::max(gap, centres - half_width(a, frames[k], n) - half_width(b, frames[l], n));
+    gap = std::max(gap, centres - half_width(a, frames[k], n) - half_width(b, frames[l], -n));
   }
   return gap - gap_rounding(centres, a.a_max, b.a_max);
 }

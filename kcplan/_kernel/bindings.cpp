@@ -270,11 +270,19 @@ NB_MODULE(_core, m) {
       .def(nb::init<const std::vector<int>&, const std::vector<double>&, const std::vector<double>&,
                     const std::vector<bool>&, const std::vector<int>&, const std::vector<double>&,
                     const std::vector<double>&, const std::vector<int>&,
-                    const std::vector<double>&, const std::vector<double>&>(),
+                    const std::vector<double>&, const std::vector<double>&,
+                    const std::vector<std::vector<double>>&, const std::vector<std::vector<int>>&>(),
            "parents"_a, "placements"_a, "axes"_a, "prismatic"_a, "states"_a, "lower"_a,
-           "upper"_a, "body_joints"_a, "body_placements"_a, "semi_axes"_a)
+           "upper"_a, "body_joints"_a, "body_placements"_a, "semi_axes"_a,
+           "hull_vertices"_a = std::vector<std::vector<double>>(),
+           "hull_triangles"_a = std::vector<std::vector<int>>())
       .def_prop_ro("dof", &kcplan::Chain::dof)
       .def_prop_ro("n_bodies", [](const kcplan::Chain& c) { return c.bodies().size(); })
+      .def_prop_ro("n_hulls", [](const kcplan::Chain& c) {
+        std::size_t n = 0;
+        for (const kcplan::ChainBody& b : c.bodies()) n += b.hull != nullptr;
+        return n;
+      })
       .def_prop_ro("point_speeds", &kcplan::Chain::point_speeds)
       .def_prop_ro("carries", &kcplan::Chain::carries)
       .def("relative_speeds", &kcplan::Chain::relative_speeds, "pairs"_a)

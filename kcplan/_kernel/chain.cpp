@@ -24,7 +24,9 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
              const std::vector<double>& axes, const std::vector<bool>& prismatic,
              const std::vector<int>& states, const std::vector<double>& lower,
              const std::vector<double>& upper, const std::vector<int>& body_joints,
-             const std::vector<double>& body_placements, const std::vector<double>& semi_axes)
+             const std::vector<double>& body_placements, const std::vector<double>& semi_axes,
+             const std::vector<std::vector<double>>& hull_vertices,
+             const std::vector<std::vector<int>>& hull_triangles)
     : lower_(lower), upper_(upper) {
   const std::size_t n = parents.size(), dof = lower.size();
   if (placements.size() != 16 * n || axes.size() != 3 * n || prismatic.size() != n ||
@@ -56,6 +58,9 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
   const std::size_t count = body_joints.size();
   if (body_placements.size() != 16 * count || semi_axes.size() != 3 * count)
     throw std::invalid_argument("chain: expected 16 placement numbers and 3 semi-axes per body");
+  if (hull_vertices.size() != hull_triangles.size() ||
+      (!hull_vertices.empty() && hull_vertices.size() != count))
+    throw std::invalid_argument("chain: expected hull vertices and triangles for every body or none");
   for (std::size_t k = 0; k < count; ++k) {
     ChainBody body;
     body.joint = body_joints[k];
@@ -68,6 +73,15 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
         throw std::invalid_argument("chain: semi-axes must be positive finite numbers");
       body.semi_axes[i] = a;
       body.a_max = std::max(body.a_max, a);
+    }
+    if (!hull_vertices.empty() && !hull_vertices[k].empty()) {
+      body.hull = std::make_shared<const BodyHull>(hull_vertices[k], hull_triangles[k]);
+      for (const coal::Vec3s& v : *body.hull->shape()->points) {
+        double inside = 0.0;  // |diag(a)^-1 v|^2: at most 1 inside the ellipsoid
+        for (int i = 0; i < 3; ++i) inside += (v[i] / body.semi_axes[i]) * (v[i] / body.semi_axes[i]);
+        if (!(inside <= 1.0 + 1e-9))
+          throw std::invalid_argument("chain: a body's hull must lie inside its semi-axes' ellipsoid");
+      }
     }
     bodies_.push_back(body);
   }

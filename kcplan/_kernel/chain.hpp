@@ -7,7 +7,11 @@
 #include <cstddef>
 #include <vector>
 
+#include <memory>
+
 #include <coal/math/transform.h>
+
+#include "convex_body.hpp"
 
 namespace kcplan {
 
@@ -22,13 +26,16 @@ struct ChainJoint {
   int state = 0;  ///< which number of the state moves it
 };
 
-/// One covering ellipsoid: semi-axes along its frame's axes, its frame `placement` in
-/// the frame of the joint that carries it (joint 0: fixed to the universe).
+/// One body of a link: an ellipsoid of semi-axes along its frame's axes, or (`hull` set)
+/// a convex body inside that ellipsoid; its frame `placement` in the frame of the joint
+/// that carries it (joint 0: fixed to the universe). Every speed bound holds for the
+/// ellipsoid, hence for a hull inside it; collision queries use the hull.
 struct ChainBody {
   int joint = 0;
   coal::Transform3s placement;
   std::array<double, 3> semi_axes{0, 0, 0};
   double a_max = 0.0;
+  std::shared_ptr<const BodyHull> hull;  ///< null: the body is the ellipsoid
 };
 
 /// The immutable description of an arm: joints, limits and covering bodies, with the
@@ -48,12 +55,17 @@ class Chain {
   /// `axes` (3 per joint), `prismatic` and `states` describe joints 1..n of the reduced
   /// model (joint 0 is the universe); `lower`, `upper` the limits in state order;
   /// `body_joints`, `body_placements` (16 per body) and `semi_axes` (3 per body) the
-  /// bodies.
+  /// bodies; `hull_vertices` and `hull_triangles` (one list per body, or none at all)
+  /// the hull of each body that is convex rather than its ellipsoid (empty lists for an
+  /// ellipsoid; m x 3 vertices in the body's frame, t x 3 indices). A hull must lie in
+  /// its body's ellipsoid (std::invalid_argument otherwise).
   Chain(const std::vector<int>& parents, const std::vector<double>& placements,
         const std::vector<double>& axes, const std::vector<bool>& prismatic,
         const std::vector<int>& states, const std::vector<double>& lower,
         const std::vector<double>& upper, const std::vector<int>& body_joints,
-        const std::vector<double>& body_placements, const std::vector<double>& semi_axes);
+        const std::vector<double>& body_placements, const std::vector<double>& semi_axes,
+        const std::vector<std::vector<double>>& hull_vertices = {},
+        const std::vector<std::vector<int>>& hull_triangles = {});
 
   int dof() const { return static_cast<int>(lower_.size()); }
   /// Joints of the reduced model, the universe included.

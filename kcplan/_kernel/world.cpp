@@ -1,6 +1,7 @@
 #include "world.hpp"
 
 #include "coal_requests.hpp"
+#include "convex_body.hpp"
 
 #include <cmath>
 #include <limits>
@@ -74,18 +75,13 @@ std::vector<coal::Triangle> triangles_of(const std::vector<int>& flat, std::size
   return faces;
 }
 
-/// A convex polytope with its triangles: coal fills the vertex neighbours from them.
+/// A convex polytope with its triangles (make_convex).
 std::shared_ptr<coal::CollisionGeometry> convex(const std::vector<Vec3s>& points,
                                                 const std::vector<int>& triangles) {
-  const std::size_t m = points.size();
-  if (m < 4 || triangles.size() < 12)
-    throw std::invalid_argument("convex: expected at least 4 vertices and 4 triangles");
-  auto faces = std::make_shared<std::vector<coal::Triangle>>(triangles_of(triangles, m, "convex"));
-  auto shape = std::make_shared<coal::Convex<coal::Triangle>>(
-      std::make_shared<std::vector<Vec3s>>(points), static_cast<unsigned int>(m), faces,
-      static_cast<unsigned int>(faces->size()));
-  shape->computeLocalAABB();
-  return shape;
+  std::vector<double> flat;
+  flat.reserve(3 * points.size());
+  for (const Vec3s& p : points) flat.insert(flat.end(), {p[0], p[1], p[2]});
+  return make_convex(flat, triangles, "convex");
 }
 
 /// Collects the obstacles whose bounding boxes meet the query object's (no narrow phase).
@@ -231,6 +227,7 @@ World::World(const Robot& robot, double half_height, double rtol, double atol)
     horizon_sides_.push_back(-1.0);
   }
   body_query_counts.assign(robot.size(), 0);
+  convex_.assign(robot.size(), 0);
   manager_ = std::make_unique<coal::DynamicAABBTreeCollisionManager>();
 }
 
@@ -445,6 +442,13 @@ double World::distance(coal::CollisionObject& object, std::size_t shape) {
   return near.best;
 }
 
+void World::set_body_shape(std::size_t k, std::shared_ptr<coal::CollisionGeometry> shape) {
+  if (k >= bodies_.size() || !shape) throw std::invalid_argument("body shape: expected a body index and a shape");
+  if (finalized_) throw std::invalid_argument("body shape: expected before the first query");
+  bodies_[k] = std::make_unique<coal::CollisionObject>(std::move(shape));
+  convex_[k] = 1;
+}
+
 void World::place_body(std::size_t k, const coal::Transform3s& frame) {
   if (!finalized_) finalize();
   bodies_[k]->setTransform(frame);
@@ -508,6 +512,7 @@ double World::body_safe_clearance(std::size_t k, const coal::Transform3s& frame,
 bool World::grown_body_clear(std::size_t k, const coal::Transform3s& frame, double scale) {
   if (!(scale >= 1.0) || !std::isfinite(scale))
     throw std::invalid_argument("grown body: expected a finite scale >= 1");
+  if (convex_[k]) return false;  // KC's guard is an ellipsoid's
   if (objects_.empty()) return true;
   if (!finalized_) finalize();
   if (grown_.empty()) grown_.resize(bodies_.size());

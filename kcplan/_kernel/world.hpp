@@ -125,6 +125,10 @@ class World {
   /// piece touches a body.
   bool free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out);
   // -- the same queries for bodies placed one by one (an arm: each body by its own frame) --
+  /// Make body k the convex `shape` instead of its ellipsoid (in the body's frame, inside
+  /// the ellipsoid: a link's hull, ChainBody::hull). Such a body has no KC guard:
+  /// grown_body_clear is false for it. Before the first query.
+  void set_body_shape(std::size_t k, std::shared_ptr<coal::CollisionGeometry> shape);
   /// Place body k alone at `frame` (world frame, finite); the others stay where they are.
   void place_body(std::size_t k, const coal::Transform3s& frame);
   /// in_collision for the bodies as placed.
@@ -145,7 +149,7 @@ class World {
   /// Whether body k grown about its centre by `scale` (its semi-axes times scale >= 1)
   /// and placed at `frame` is certainly clear of every obstacle: its clearance, reduced by
   /// the error allowance, is positive (one body query; the KC guard of arms). The body
-  /// itself stays where it is.
+  /// itself stays where it is. False, with no query, for a body of set_body_shape.
   bool grown_body_clear(std::size_t k, const coal::Transform3s& frame, double scale);
   /// Whether body k as placed touches an obstacle (one body's part of bodies_collide;
   /// counted as a body query, not as a collision query).
@@ -242,6 +246,7 @@ class World {
   std::vector<std::unique_ptr<const MeshPlanes>> planes_;  // per obstacle; null: not a mesh
   std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
   std::vector<std::unique_ptr<coal::CollisionObject>> grown_;  // per body, made on first use
+  std::vector<char> convex_;  // per body: its shape is set_body_shape's, not the ellipsoid
   std::vector<std::unique_ptr<coal::CollisionObject>> horizon_boxes_;
   std::shared_ptr<coal::Sphere> ball_shape_;  // ball queries' shape and object (place_ball)
   std::unique_ptr<coal::CollisionObject> ball_;

@@ -248,15 +248,16 @@ def mbm_scenario(
     urdf: str | os.PathLike,
     srdf: str | os.PathLike | None,
     output: str | os.PathLike,
-    bodies_per_link: int | None = 4,
+    bodies_per_link: int | None = None,
     max_offset: float | None = None,
+    representation: str | None = None,
 ) -> dict:
     """The arm scenario (:mod:`kcplan.arm.scenario`, as plain data) of one problem: its
     obstacles, start and goal for the goal's joints, every other joint of the URDF fixed
     at its start value, and the allowed collision matrix; robot paths relative to the
-    folder of ``output``. ``bodies_per_link`` and ``max_offset`` (metres) choose the
-    cover as the scenario's fields of those names do; both None: kcplan's default cover
-    (:data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`)."""
+    folder of ``output``. ``representation``, ``bodies_per_link`` and ``max_offset``
+    (metres) choose the links' bodies as the scenario's fields of those names do; all
+    None: kcplan's default, each link its own convex hull (:mod:`kcplan.arm.hulls`)."""
     import pinocchio as pin
 
     folder = Path(output).resolve().parent
@@ -270,6 +271,8 @@ def mbm_scenario(
     if srdf is not None:
         robot["srdf"] = os.path.relpath(Path(srdf).resolve(), folder)
     robot["joints"] = list(problem.joints)
+    if representation is not None:
+        robot["representation"] = str(representation)
     if bodies_per_link is not None:
         robot["bodies_per_link"] = int(bodies_per_link)
     if max_offset is not None:

@@ -1,4 +1,4 @@
-"""An arm robot from its URDF: the chain, its joint limits and the ellipsoids that cover
+"""An arm robot from its URDF: the chain, its joint limits and the bodies that represent
 its links, as one immutable description.
 
 Pinocchio reads the URDF (``pinocchio.buildModelFromUrdf``: joints, limits, placements)
@@ -8,7 +8,13 @@ list of joints in state order; every other joint is locked at a fixed value
 (``pinocchio.buildReducedModel``), so the reduced model's configuration is exactly the
 group's joint vector (``nq`` = number of joints in the group).
 
-Every collision geometry is covered by ellipsoids: a mesh by :mod:`kcplan.cover` (its own
+*Representations.* By default (``representation="hulls"``) every link is its own convex
+geometry (:mod:`kcplan.arm.hulls`): a mesh by its convex hull (exact for a convex mesh,
+the smallest convex body holding a non-convex one), a box exactly, a cylinder by a
+circumscribed prism, a sphere exactly (as an ellipsoid). Such a body keeps a bounding
+ball (``semi_axes`` all equal to its radius) for the speed bounds, and its hull for the
+collision queries. With ``representation="ellipsoids"`` every collision geometry is
+covered by ellipsoids (what the KC certificate needs): a mesh by :mod:`kcplan.cover` (its own
 triangles, a sound cover, cached per user; by default cut until it sticks out of the mesh
 by at most :data:`DEFAULT_MAX_OFFSET`, or a fixed number of bodies per link; a mesh that
 is not closed, such as the Panda's link6, by a cover of its convex hull, which holds every
@@ -41,6 +47,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, mesh_hull
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
@@ -49,6 +56,7 @@ from kcplan.geometry.robot import MAX_BODIES
 
 __all__ = [
     "DEFAULT_MAX_OFFSET",
+    "REPRESENTATIONS",
     "JOINT_KINDS",
     "ArmBody",
     "ArmError",
@@ -70,6 +78,9 @@ the hand stop at :data:`kcplan.cover.fit.MAX_OFFSET_BODIES` bodies, 12-21 mm out
 13,056 self pairs, against 44 and 336 for 4 bodies per link, and about 20 minutes to fit
 once (cached). With at most 16 bodies per link: 148 bodies, 3,584 self pairs, 655 of 700
 goals."""
+
+REPRESENTATIONS = ("hulls", "ellipsoids")
+"""How links are represented (module docstring); the first is the default."""
 
 JOINT_KINDS = {
     "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
@@ -93,7 +104,7 @@ class ArmError(ValueError):
 
 @dataclass(frozen=True, eq=False)
 class ArmBody:
-    """One covering ellipsoid of a link.
+    """One body of a link: a covering ellipsoid, or the link's convex hull.
 
     Attributes
     ----------
@@ -107,7 +118,10 @@ class ArmBody:
     placement : ndarray, shape (4, 4)
         The body's frame in the joint's frame (its centre and axes).
     semi_axes : ndarray, shape (3,)
-        Along the body frame's x, y, z, in metres.
+        Along the body frame's x, y, z, in metres: the ellipsoid, or for a hull its
+        bounding ball (three times its radius), which holds it.
+    hull : BodyHull or None
+        The convex body in the body's frame, or None for an ellipsoid.
     """
 
     link: str
@@ -115,6 +129,7 @@ class ArmBody:
     joint: int
     placement: NDArray[np.float64]
     semi_axes: NDArray[np.float64]
+    hull: BodyHull | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,8 +212,9 @@ def load_arm(
     package_dirs: Sequence[str | os.PathLike] | None = None,
     progress: Callable[[str], None] | None = None,
     max_offset: float | None = None,
+    representation: str | None = None,
 ) -> ArmModel:
-    """Read an arm from its URDF (and SRDF) and cover its links by ellipsoids.
+    """Read an arm from its URDF (and SRDF) and represent its links by bodies.
 
     Parameters
     ----------
@@ -225,6 +241,10 @@ def load_arm(
         Cut each mesh's cover until no body sticks out of the mesh by more than this, in
         metres (a proved bound, :mod:`kcplan.cover.offset`). When neither this nor
         ``bodies_per_link`` is given: :data:`DEFAULT_MAX_OFFSET`.
+    representation : {"hulls", "ellipsoids"}, optional
+        Links as their convex hulls, or as ellipsoid covers (module docstring). Default:
+        ``"ellipsoids"`` when ``bodies_per_link`` or ``max_offset`` is given, else
+        ``"hulls"``.
 
     Raises
     ------
@@ -234,7 +254,20 @@ def load_arm(
     import pinocchio as pin  # imported here: the rigid planners never need it
 
     source = os.fspath(urdf)
-    if bodies_per_link is None and max_offset is None:
+    if representation is None:
+        cover_asked = bodies_per_link is not None or max_offset is not None
+        representation = "ellipsoids" if cover_asked else REPRESENTATIONS[0]
+    if representation not in REPRESENTATIONS:
+        raise ArmError(
+            f"{source}: representation: expected one of {', '.join(REPRESENTATIONS)}, "
+            f"got {representation!r}"
+        )
+    if representation == "hulls" and (bodies_per_link is not None or max_offset is not None):
+        raise ArmError(
+            f"{source}: representation: bodies_per_link and max_offset are for "
+            "ellipsoid covers, got them with hulls"
+        )
+    if representation == "ellipsoids" and bodies_per_link is None and max_offset is None:
         max_offset = DEFAULT_MAX_OFFSET
     if bodies_per_link is not None and not (
         isinstance(bodies_per_link, int) and 1 <= bodies_per_link <= MAX_BODIES
@@ -309,6 +342,12 @@ def load_arm(
     for index, obj in enumerate(geometry.geometryObjects):
         placement = np.asarray(obj.placement.homogeneous, dtype=float)
         link = model.frames[obj.parentFrame].name
+        if representation == "hulls":
+            frame, semi_axes, hull = _hull(obj, source, progress)
+            bodies.append(
+                ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes, hull)
+            )
+            continue
         for frame, semi_axes in _cover(obj, bodies_per_link, max_offset, source, progress):
             bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
     self_pairs = _self_pairs(geometry, bodies)
@@ -336,6 +375,44 @@ def _group(full, joints: Sequence[str], source: str) -> list[str]:
                 "prismatic joint with limits"
             )
     return group
+
+
+def _hull(
+    obj, source: str, progress: Callable[[str], None] | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], BodyHull | None]:
+    """``(frame, semi_axes, hull)`` of one geometry as its own convex body (module
+    docstring), the frame ``(4, 4)`` in the geometry's frame; a sphere is an ellipsoid
+    (``hull`` None)."""
+    shape = obj.geometry
+    kind = type(shape).__name__
+    frame = np.eye(4)
+    if kind == "Sphere":
+        return frame, np.full(3, float(shape.radius)), None
+    if kind == "Box":
+        centre, hull = box_hull(np.asarray(shape.halfSide, dtype=float))
+    elif kind == "Cylinder":
+        centre, hull = cylinder_hull(float(shape.radius), float(shape.halfLength))
+    elif obj.meshPath:
+        scale = np.asarray(obj.meshScale, dtype=float)
+        if not np.allclose(scale, scale[0]):
+            raise ArmError(
+                f"{source}: collision: {obj.name}: expected a uniform mesh scale, "
+                f"got {scale.tolist()}"
+            )
+        start = time.perf_counter()
+        try:
+            centre, hull = mesh_hull(obj.meshPath, float(scale[0]))
+        except ValueError as err:
+            raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
+        took = time.perf_counter() - start
+        if progress is not None and took > 1.0:  # a large mesh: say where the time goes
+            progress(f"{obj.name}: convex hull of {len(hull.vertices)} vertices in {took:.1f} s")
+    else:
+        raise ArmError(
+            f"{source}: collision: {obj.name}: expected a mesh, box, cylinder or sphere, got {kind}"
+        )
+    frame[:3, 3] = centre
+    return frame, np.full(3, hull.radius), hull
 
 
 def _cover(

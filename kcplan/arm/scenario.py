@@ -5,7 +5,7 @@ The format (``scenarios/README.md``)::
     name: box_1
     robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,
             joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
-            bodies_per_link: K, max_offset: E, inflation: 0.0}
+            representation: hulls, bodies_per_link: K, max_offset: E, inflation: 0.0}
     start: {joints: [...]}            # the group's values, in ``joints`` order
     goal: {joints: [...]}
     obstacles: [{box: {center, size, quaternion}}, {cylinder: {center, quaternion,
@@ -15,6 +15,8 @@ The format (``scenarios/README.md``)::
 
 Paths are relative to the scenario file. ``joints`` is the planning group in state
 order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`).
+``representation`` is ``hulls`` (each link its own convex hull, the default) or
+``ellipsoids`` (covers; the default when ``bodies_per_link`` or ``max_offset`` is given).
 ``max_offset`` (metres) cuts each link's cover until it sticks out of the link's mesh by
 at most that much, with ``bodies_per_link`` as the most bodies per link; ``bodies_per_link``
 alone fits exactly that many (the smallest union); neither gives
@@ -36,7 +38,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.model import ArmError, ArmModel, load_arm
+from kcplan.arm.model import REPRESENTATIONS, ArmError, ArmModel, load_arm
 from kcplan.world.scenario import (
     MAX_OBSTACLES,
     Obstacle,
@@ -123,7 +125,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
     spec = r.mapping(
         top["robot"], "robot", ("urdf", "joints"),
-        ("srdf", "fixed", "bodies_per_link", "max_offset", "inflation"),
+        ("srdf", "fixed", "representation", "bodies_per_link", "max_offset", "inflation"),
     )  # fmt: skip
     urdf = directory / r.text(spec["urdf"], "robot.urdf")
     srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
@@ -146,13 +148,19 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     max_offset = None
     if "max_offset" in spec:
         max_offset = r.number(spec["max_offset"], "robot.max_offset", positive=True)
+    representation = spec.get("representation")
+    if representation is not None and representation not in REPRESENTATIONS:
+        r.fail("robot.representation", f"one of {', '.join(REPRESENTATIONS)}", representation)
+    if representation == "hulls" and (bodies is not None or max_offset is not None):
+        r.fail("robot.representation", "ellipsoids with bodies_per_link or max_offset",
+               representation)  # fmt: skip
     inflation = r.number(spec.get("inflation", 0.0), "robot.inflation")
     if inflation < 0:
         r.fail("robot.inflation", "a number >= 0", inflation)
     try:
         arm = load_arm(
             urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice,
-            max_offset=max_offset,
+            max_offset=max_offset, representation=representation,
         )  # fmt: skip
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None

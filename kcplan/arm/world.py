@@ -1,4 +1,4 @@
-"""Collision and clearance queries of an arm's covering ellipsoids, on python-fcl.
+"""Collision and clearance queries of an arm's bodies (ellipsoids or link hulls), on python-fcl.
 
 The reference world of arms (the compiled kernel will hold its twin): the bodies of an
 :class:`kcplan.arm.ArmModel` placed at a joint configuration (:func:`body_frames`),
@@ -15,6 +15,8 @@ the *direction* from FCL's nearest points and the distance from the two shapes' 
 support functions along it (:func:`kcplan.world.support.separation`), a lower bound
 whatever FCL's error; a mesh obstacle, which has no support function, keeps FCL's
 distance. The ``safe_*`` queries then subtract the rigid world's allowance as well.
+A link's hull (:attr:`kcplan.arm.ArmBody.hull`) is an ``fcl.Convex`` whose support
+function is its vertices' (:class:`kcplan.world.support.PointsSupport`).
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import ArmModel
 from kcplan.world.collision import CLEARANCE_ATOL, CLEARANCE_RTOL, fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
-from kcplan.world.support import EllipsoidSupport, piece_supports, separation
+from kcplan.world.support import EllipsoidSupport, PointsSupport, piece_supports, separation
 
 __all__ = ["ArmWorld", "checked_pairs"]
 
@@ -89,7 +91,7 @@ class ArmWorld:
         self.allowed = frozenset(allowed)
         self.self_pairs = checked_pairs(arm, self.allowed)
         """The pairs of :attr:`ArmModel.self_pairs` whose links are not allowed to touch."""
-        self._shapes = [fcl.Ellipsoid(*b.semi_axes.tolist()) for b in arm.bodies]
+        self._shapes = [_fcl_shape(b) for b in arm.bodies]
         self._bodies = [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
         self._objects, self._supports, boxes = [], [], []
         for ob in self.obstacles:
@@ -148,13 +150,13 @@ class ArmWorld:
             )
         return q
 
-    def _place(self, state: ArrayLike) -> list[EllipsoidSupport]:
+    def _place(self, state: ArrayLike) -> list:
         """Place the bodies at ``state``; their support functions there."""
         supports = []
         frames = body_frames(self.arm, self._joints(state))
         for obj, frame, body in zip(self._bodies, frames, self.arm.bodies, strict=True):
             obj.setTransform(fcl.Transform(frame[:3, :3], frame[:3, 3]))
-            supports.append(EllipsoidSupport(frame[:3, 3], frame[:3, :3], body.semi_axes))
+            supports.append(_support(body, frame))
         return supports
 
     def _distance(self, k: int, support_a, b: fcl.CollisionObject, support_b) -> float:
@@ -199,12 +201,18 @@ class ArmWorld:
                 return True
         return False
 
-    def _body_boxes(self, supports: list[EllipsoidSupport]) -> NDArray[np.float64]:
+    def _body_boxes(self, supports: list) -> NDArray[np.float64]:
         """Bounding boxes of the placed bodies, ``(bodies, 2, 3)``: the ellipsoid
-        ``c + M^T u`` (``M = diag(a) R^T``) spans ``c_i +- |M e_i|`` along axis ``i``."""
-        centres = np.array([s.center for s in supports]).reshape(-1, 3)
-        half = np.array([np.linalg.norm(s.shape, axis=0) for s in supports]).reshape(-1, 3)
-        return np.stack([centres - half, centres + half], axis=1)
+        ``c + M^T u`` (``M = diag(a) R^T``) spans ``c_i +- |M e_i|`` along axis ``i``; a
+        hull its vertices' box."""
+        boxes = np.empty((len(supports), 2, 3))
+        for k, s in enumerate(supports):
+            if isinstance(s, PointsSupport):
+                boxes[k] = s.vertices.min(axis=0), s.vertices.max(axis=0)
+            else:
+                half = np.linalg.norm(s.shape, axis=0)
+                boxes[k] = s.center - half, s.center + half
+        return boxes
 
     def clearances(self, state: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Distances at ``state``, never too large (module docstring): of each body to the
@@ -230,7 +238,7 @@ class ArmWorld:
         times ``scale >= 1``), is certainly clear of the obstacles, ``(bodies,)``: its
         distance (module docstring) less FCL's allowance is positive. These are the KC
         guards of :mod:`kcplan.planning.arm_certifier`; self pairs are not looked at (one
-        collision query)."""
+        collision query). A hull body has no KC guard: False, not asked."""
         if not (math.isfinite(scale) and scale >= 1.0):
             raise ValueError(f"scale: expected a finite number >= 1, got {scale!r}")
         frames = body_frames(self.arm, self._joints(state))
@@ -239,6 +247,9 @@ class ArmWorld:
         if not self._objects:
             return clear
         for k, (frame, body) in enumerate(zip(frames, self.arm.bodies, strict=True)):
+            if body.hull is not None:
+                clear[k] = False  # KC's guard is an ellipsoid's
+                continue
             axes = scale * body.semi_axes
             grown = fcl.Ellipsoid(*axes.tolist())
             obj = fcl.CollisionObject(grown, fcl.Transform(frame[:3, :3], frame[:3, 3]))
@@ -252,7 +263,7 @@ class ArmWorld:
                     break
         return clear
 
-    def _pair_clearances(self, supports: list[EllipsoidSupport]) -> NDArray[np.float64]:
+    def _pair_clearances(self, supports: list) -> NDArray[np.float64]:
         """The self pairs' separations along FCL's nearest points, ``(pairs,)``, with the
         bodies placed (:func:`kcplan.world.support.separation` for all pairs at once)."""
         m = len(self.self_pairs)
@@ -269,6 +280,12 @@ class ArmWorld:
         length = np.linalg.norm(directions, axis=1)
         touching |= length == 0.0
         n = directions / np.where(touching, 1.0, length)[:, None]
+        if any(b.hull is not None for b in self.arm.bodies):  # one pair at a time
+            gaps = [
+                0.0 if touching[row] else separation(supports[i], supports[j], n[row])
+                for row, (i, j) in enumerate(self.self_pairs)
+            ]
+            return np.maximum(np.array(gaps, dtype=float), 0.0)
         centres = np.array([s.center for s in supports]).reshape(-1, 3)
         shapes = np.array([s.shape for s in supports]).reshape(-1, 3, 3)
         first, second = self.self_pairs[:, 0], self.self_pairs[:, 1]
@@ -285,3 +302,19 @@ class ArmWorld:
 
     def _safe(self, d: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+
+
+def _fcl_shape(body):
+    """The body's FCL shape: its hull as a Convex, else its ellipsoid."""
+    if body.hull is None:
+        return fcl.Ellipsoid(*body.semi_axes.tolist())
+    triangles = body.hull.triangles
+    faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
+    return fcl.Convex(body.hull.vertices, len(triangles), faces)
+
+
+def _support(body, frame: NDArray[np.float64]):
+    """The body's support function at ``frame`` ``(4, 4)``."""
+    if body.hull is None:
+        return EllipsoidSupport(frame[:3, 3], frame[:3, :3], body.semi_axes)
+    return PointsSupport(body.hull.vertices @ frame[:3, :3].T + frame[:3, 3])

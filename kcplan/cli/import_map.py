@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from kcplan.arm.model import REPRESENTATIONS
 from kcplan.cli.common import InputError, Parser, output_file, positive_float, positive_int
 
 
@@ -73,10 +74,10 @@ def _run_mbm(args: argparse.Namespace, out: Path) -> int:
         for option, path in (("--urdf", args.urdf), ("--srdf", args.srdf)):
             if path is not None and not Path(path).is_file():
                 raise InputError(f"{path}: {option}: expected an existing file")
-        bodies = args.bodies_per_link
-        if bodies is None and args.max_offset is None:
-            bodies = 4
-        data = mbm_scenario(problem, name, args.urdf, args.srdf, out, bodies, args.max_offset)
+        data = mbm_scenario(
+            problem, name, args.urdf, args.srdf, out, args.bodies_per_link, args.max_offset,
+            args.representation,
+        )  # fmt: skip
         scenario = parse_scenario(data, str(out), out.parent, check=True)
     except (MbmError, ScenarioError) as err:
         raise InputError(str(err)) from None
@@ -145,7 +146,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Convert one MotionBenchMaker problem into an arm scenario: its "
         "obstacles, the request's start and goal for the goal's joints (the planning "
         "group), every other joint fixed at its start value, the scene's allowed collision "
-        "matrix. The start and goal must be free for the covered arm.",
+        "matrix. The start and goal must be free for the arm's representation.",
     )
     q.add_argument("scene", nargs="?", metavar="SCENE.yaml")
     q.add_argument("request", nargs="?", metavar="REQUEST.yaml")
@@ -155,10 +156,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--urdf", required=True, metavar="ROBOT.urdf")
     q.add_argument("--srdf", metavar="ROBOT.srdf")
     q.add_argument(
+        "--representation",
+        choices=REPRESENTATIONS,
+        help="the links as their own convex hulls (the default: exact for a convex link, "
+        "nothing fitted) or as ellipsoid covers (what the KC certificate needs; the default "
+        "with --bodies-per-link or --max-offset)",
+    )
+    q.add_argument(
         "--bodies-per-link",
         type=positive_int,
-        help="ellipsoids per link (default 4, fitted in about 40 s for the Panda); with "
-        "--max-offset the most per link (default 32)",
+        help="ellipsoids per link (4: bundled for the Panda); with --max-offset the most "
+        "per link (default 32)",
     )
     q.add_argument(
         "--max-offset",

@@ -128,7 +128,7 @@ class PinChecker:
                     int(body.joint),
                     int(arm.model.getFrameId(body.link)),
                     pin.SE3(np.asarray(body.placement, dtype=float)),
-                    coal.Ellipsoid(*np.asarray(body.semi_axes, dtype=float).tolist()),
+                    _coal_shape(coal, body),
                 )
             )
         first = len(arm.bodies)
@@ -173,3 +173,15 @@ class PinChecker:
         joint limits and not :meth:`in_collision`."""
         q = np.array([state[j] for j in range(self.arm.dof)])
         return self.arm.within_limits(q) and not self.in_collision(q)
+
+
+def _coal_shape(coal, body):
+    """The body's coal shape: its hull as a Convex, else its ellipsoid."""
+    if body.hull is None:
+        return coal.Ellipsoid(*np.asarray(body.semi_axes, dtype=float).tolist())
+    points, triangles = coal.StdVec_Vec3s(), coal.StdVec_Triangle()
+    for v in body.hull.vertices:
+        points.append(np.asarray(v, dtype=float))
+    for t in body.hull.triangles.tolist():
+        triangles.append(coal.Triangle(*t))
+    return coal.Convex(points, triangles)

@@ -23,15 +23,30 @@ def check_start_goal(scenario: Scenario) -> None:
     """Raise :class:`ScenarioError` naming the obstacles the robot touches at the start or
     the goal (``FILE: start: the robot collides with obstacles[3] (box)``)."""
     if not isinstance(scenario, Scenario):  # an arm
+        from kcplan.arm.verify import verify_arm_path
         from kcplan.arm.world import ArmWorld
 
-        arm_world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)
+        arm, obstacles = scenario.arm, scenario.obstacles
+        arm_world = ArmWorld(arm, obstacles, allowed=scenario.allowed)
         for key, q in (("start", scenario.start), ("goal", scenario.goal)):
-            if arm_world.in_collision(q):
+            if not arm_world.in_collision(q):
+                continue
+            if verify_arm_path(arm, obstacles, [q, q], allowed=scenario.allowed).collides:
                 raise ScenarioError(
-                    f"{scenario.source}: {key}: the arm's cover touches an obstacle or "
-                    "itself (more bodies per link may free it: robot.bodies_per_link)"
+                    f"{scenario.source}: {key}: the arm's links touch an obstacle or each "
+                    "other (on their own collision meshes too)"
                 )
+            hulls = any(b.hull is not None for b in arm.bodies)
+            hint = (
+                "robot.representation: ellipsoids with a small robot.max_offset may free it"
+                if hulls
+                else "robot.representation: hulls (the default) may free it"
+            )
+            what = "hulls touch" if hulls else "cover touches"
+            raise ScenarioError(
+                f"{scenario.source}: {key}: the arm's {what} an obstacle or itself, its "
+                f"meshes do not ({hint})"
+            )
         return
     world = CollisionWorld(scenario)
     for key, pose in (("start", scenario.start), ("goal", scenario.goal)):

@@ -1,0 +1,173 @@
+"""Links as their own convex hulls (kcplan.arm.hulls, the default arm representation).
+
+The hulls hold their meshes (proved, checked here against every vertex), the compiled
+kernel and its Python twin agree on them (the twins' tests of test_arm_kernel, run again
+on hulls), and every edge the kernel accepts is free on the links' own meshes (checked by
+kcplan.arm.verify, which knows nothing of the certificate)."""
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+from conftest import PANDA, PANDA_GROUP
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from test_arm_kernel import (  # noqa: F401 - the twins' tests, collected again on hulls
+    EXTRA_OBSTACLES,
+    test_first_order_bounds_hold_and_are_the_kernels,
+    test_kernel_and_python_agree_on_every_state,
+    test_kernel_certifier_decides_as_the_python_certifier,
+    test_kernel_frames_are_pinocchios,
+    test_kernel_levers_are_the_python_levers,
+    test_kernel_speed_bounds_are_the_python_bounds,
+    test_part_balls_decide_every_edge_as_every_pair_does,
+    test_queries_between_edges_answer_as_a_fresh_world,
+    test_relative_first_order_bounds_the_pairs_and_is_the_kernels,
+    test_the_kernel_never_certifies_a_bad_state,
+    test_the_local_bound_holds_along_random_edges,
+)
+
+from kcplan._kernel import _core
+from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm.hulls import CYLINDER_SIDES, box_hull, cylinder_hull, points_hull
+from kcplan.arm.kinematics import body_frames
+from kcplan.arm.verify import verify_arm_path
+from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.world import ScenarioError, parse_scenario
+
+BODIES_PER_LINK = None  # the panda fixture (conftest): each link its own hull
+
+
+def outside(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray) -> float:
+    """The largest ``n . p - h`` over the points and the hull's face planes (<= 0: every
+    point inside), the planes from the hull's own triangles."""
+    a, b, c = (vertices[triangles[:, i]] for i in range(3))
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    return float((points @ n.T - np.einsum("ij,ij->i", n, a)).max())
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    arrays(np.float64, st.tuples(st.integers(4, 60), st.just(3)), elements=st.floats(-1, 1)),
+    st.floats(1e-3, 1e2),
+)
+def test_a_points_hull_holds_every_point(points, scale):
+    points = points * scale
+    try:
+        centre, hull = points_hull(points)
+    except ValueError as err:  # flat or too few distinct points: refused, with a reason
+        assert "volume" in str(err) or "degenerate" in str(err)
+        return
+    assert outside(points - centre, hull.vertices, hull.triangles) <= 1e-15 * scale
+    assert hull.radius >= np.linalg.norm(hull.vertices, axis=1).max()
+    assert hull.offset >= 0.0
+
+
+def test_primitives_become_exact_or_enclosing_hulls():
+    centre, box = box_hull(np.array([0.1, 0.2, 0.3]))
+    np.testing.assert_allclose(centre, 0.0, atol=1e-15)
+    np.testing.assert_allclose(np.abs(box.vertices), [[0.1, 0.2, 0.3]] * 8, rtol=1e-15)
+    assert box.radius == pytest.approx(math.sqrt(0.14), rel=1e-9)
+    centre, prism = cylinder_hull(0.05, 0.2)
+    assert len(prism.vertices) == 2 * CYLINDER_SIDES
+    angles = np.linspace(0.0, 2.0 * math.pi, 1000)
+    rim = np.column_stack([0.05 * np.cos(angles), 0.05 * np.sin(angles), np.full(1000, 0.2)])
+    assert outside(rim - centre, prism.vertices, prism.triangles) <= 1e-15
+    assert prism.radius <= math.hypot(0.05 / math.cos(math.pi / CYLINDER_SIDES), 0.2) * 1.000001
+
+
+def test_the_pandas_links_are_their_meshes_hulls(panda):
+    """The default Panda: one body per link, each the hull of its mesh (every mesh vertex
+    inside, the hull's volume that of the mesh's hull), inside its bounding ball; 21 self
+    pairs where the 2-ellipsoid cover has 84."""
+    assert len(panda.bodies) == 11 and all(b.hull is not None for b in panda.bodies)
+    assert len(panda.self_pairs) == 21
+    for body in panda.bodies:
+        obj = panda.geometry.geometryObjects[body.geometry]
+        mesh = trimesh.load(obj.meshPath, force="mesh", process=False)
+        local = np.linalg.inv(np.asarray(obj.placement.homogeneous)) @ body.placement
+        # the mesh in the body's frame: placement = geometry placement @ [I | centre]
+        points = mesh.vertices - local[:3, 3]
+        assert outside(points, body.hull.vertices, body.hull.triangles) <= 1e-15
+        hull = trimesh.Trimesh(body.hull.vertices, body.hull.triangles)
+        assert hull.volume == pytest.approx(mesh.convex_hull.volume, rel=1e-9)
+        np.testing.assert_array_equal(body.semi_axes, [body.hull.radius] * 3)
+
+
+def test_the_kernel_holds_a_hull_to_its_ellipsoid(panda):
+    """A hull that sticks out of the ellipsoid its speed bounds are for is refused."""
+    chain = _core.Chain  # the arguments of kcplan._kernel.kernel_chain, one body
+    body = panda.bodies[3]
+    vertices, triangles = body.hull.vertices, body.hull.triangles
+    args = ([0], np.eye(4).ravel().tolist(), [0.0, 0.0, 1.0], [False], [0], [-1.0], [1.0], [1],
+            np.eye(4).ravel().tolist())  # fmt: skip
+    ok = chain(*args, [body.hull.radius] * 3, [vertices.ravel().tolist()],
+               [triangles.ravel().tolist()])  # fmt: skip
+    assert ok.n_hulls == 1
+    with pytest.raises(ValueError, match="hull must lie inside its semi-axes' ellipsoid"):
+        chain(*args, [0.9 * body.hull.radius] * 3, [vertices.ravel().tolist()],
+              [triangles.ravel().tolist()])  # fmt: skip
+    with pytest.raises(ValueError, match="hull: triangle index out of range"):
+        chain(*args, [body.hull.radius] * 3, [vertices.ravel().tolist()], [[0, 1, 9999] * 4])
+
+
+def test_a_hull_has_no_kc_guard_and_keeps_the_ball(panda, world, states):
+    """KC's guard is an ellipsoid's: hull bodies are never grown (Python: not clear; the
+    kernel: no query), and the kernel with kc_inflation decides as without it."""
+    q = next(q for q in states if not world.in_collision(q))
+    assert not world.grown_clear(q, 1.5).any()
+    free = [q for q in states if not world.in_collision(q)][:30]
+    kc, ball = KernelArmCertifier(world, kc_inflation=0.5), KernelArmCertifier(world)
+    for q1, q2 in zip(free, free[1:], strict=False):
+        assert kc.check(q1, q1 + 0.4 * (q2 - q1)) == ball.check(q1, q1 + 0.4 * (q2 - q1))
+    assert kc.counters["grown_queries"] == 0 and kc.counters["kc_reaches"] == 0
+    assert kc.counters["guards"] == ball.counters["guards"] > 0
+
+
+def test_every_edge_the_kernel_accepts_on_hulls_is_free_on_the_meshes(panda, world, states):
+    """Random edges of every length, each accepted one checked without gaps on the links'
+    own meshes (kcplan.arm.verify: conservative advancement on FCL, no certificate)."""
+    free = [q for q in states if not world.in_collision(q)]
+    kernel = KernelArmCertifier(world)
+    rng = np.random.default_rng(17)
+    accepted = rejected = 0
+    for _ in range(120):
+        q1, q2 = free[rng.integers(len(free))], free[rng.integers(len(free))]
+        q2 = q1 + rng.choice([0.02, 0.1, 0.3, 1.0]) * (q2 - q1)
+        if kernel.check(q1, q2):
+            accepted += 1
+            check = verify_arm_path(panda, world.obstacles, [q1, q2])
+            assert not check.collides, (q1, q2, check)
+        else:
+            rejected += 1
+    assert accepted >= 30 and rejected >= 10
+
+
+def test_the_hull_world_is_the_meshes_world_on_states(panda, world, states):
+    """On a convex link the hull is the mesh: a state collides for the hulls exactly when
+    it does for the meshes, except where the open link6's hull closes it (none here)."""
+    meshes = [verify_arm_path(panda, world.obstacles, [q, q]).collides for q in states[:80]]
+    hulls = [world.kernel.in_collision(q.tolist()) for q in states[:80]]
+    assert hulls == meshes and 5 < sum(hulls) < 75
+
+
+def test_the_representation_is_a_checked_scenario_field():
+    base = {
+        "name": "r", "robot": {"urdf": str(PANDA / "panda.urdf"), "joints": PANDA_GROUP},
+        "start": {"joints": [0.0] * 7}, "goal": {"joints": [0.0] * 7},
+    }  # fmt: skip
+    for spec, message in (
+        ({"representation": "spheres"}, "robot.representation: expected one of hulls, ell"),
+        ({"representation": "hulls", "bodies_per_link": 4}, "representation: expected ellipsoids"),
+    ):  # fmt: skip
+        data = {**base, "robot": {**base["robot"], **spec}}
+        with pytest.raises(ScenarioError, match=message):
+            parse_scenario(data, "r.yaml", PANDA.parent, check=False)
+    arm = load_arm(PANDA / "panda.urdf", PANDA_GROUP)  # no SRDF: more pairs checked
+    assert all(b.hull is not None for b in arm.bodies) and len(arm.self_pairs) > 21
+    frames = body_frames(arm, np.zeros(7))
+    assert frames.shape == (len(arm.bodies), 4, 4)
+    assert ArmWorld(arm, ()).kernel.chain.n_hulls == len(arm.bodies)
