@@ -182,7 +182,7 @@ def test_primitives_are_covered_by_their_enclosing_ellipsoids(tmp_path):
             "<axis xyz='0 1 0'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
         )
     urdf.write_text("".join(parts) + "</robot>")
-    arm = load_arm(urdf, [f"j_{n}" for n in links])
+    arm = load_arm(urdf, [f"j_{n}" for n in links], representation="ellipsoids")
     assert sorted(b.link for b in arm.bodies) == sorted(links)  # Pinocchio's order
     box, can, ball = (next(b for b in arm.bodies if b.link == name) for name in links)
     assert box.semi_axes == pytest.approx(math.sqrt(3) * np.array([0.1, 0.2, 0.3]))
@@ -197,6 +197,13 @@ def test_primitives_are_covered_by_their_enclosing_ellipsoids(tmp_path):
         assert ((points / body.semi_axes) ** 2).sum(axis=1) == pytest.approx(1.0)
     assert box.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.0])
     assert ball.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.2])
+    # as hulls (the default): the box exactly, the cylinder in a prism, the ball as is
+    hulls = load_arm(urdf, [f"j_{n}" for n in links])
+    box, can, ball = (next(b for b in hulls.bodies if b.link == name) for name in links)
+    assert sorted(map(tuple, box.hull.vertices.round(12))) == sorted(map(tuple, corners))
+    assert len(can.hull.vertices) == 64 and ball.hull is None
+    assert ball.semi_axes == pytest.approx([0.15] * 3)
+    assert can.placement[:3, 3] == pytest.approx([0.0, 0.0, 0.1])
 
 
 def _surface_points(arm, frames, count=24, seed=0):
@@ -308,13 +315,14 @@ UR5_GROUP = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_
 def test_the_default_covers_come_checked_from_the_bundle(
     urdf, group, per_link, bodies, pairs, tmp_path, monkeypatch
 ):
-    """Every machine plans MBM's robots with the same default cover (kcplan/cover/bundled),
-    and so the bundled scenarios' Panda (4 bodies a link), and none is fitted: the
+    """Every machine plans MBM's robots with the same default ellipsoid cover
+    (kcplan/cover/bundled), and the Panda at 4 bodies a link, and none is fitted: the
     benchmarks' body and pair counts, nothing written to the cache."""
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
     lines: list[str] = []
     srdf = urdf.with_suffix(".srdf")
-    arm = load_arm(urdf, group, srdf=srdf, bodies_per_link=per_link, progress=lines.append)
+    arm = load_arm(urdf, group, srdf=srdf, bodies_per_link=per_link, progress=lines.append,
+                   representation="ellipsoids")  # fmt: skip
     assert (len(arm.bodies), len(arm.self_pairs)) == (bodies, pairs)
     assert lines and all(" bundled" in line and "fitted" not in line for line in lines)
     assert not list(tmp_path.iterdir())
@@ -401,7 +409,7 @@ def test_link_covers_are_cut_until_they_stick_out_at_most_max_offset(tmp_path, m
     )
     assert "stopped at 2 bodies, the most asked for" in capped[0]
     assert len(load_arm(urdf, ["j"], bodies_per_link=2).bodies) == 2
-    default = load_arm(urdf, ["j"])
+    default = load_arm(urdf, ["j"], representation="ellipsoids")
     same = load_arm(urdf, ["j"], max_offset=DEFAULT_MAX_OFFSET)
     assert [b.semi_axes.tolist() for b in default.bodies] == [
         b.semi_axes.tolist() for b in same.bodies

@@ -33,6 +33,7 @@ from kcplan._kernel import _core
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.hulls import CYLINDER_SIDES, box_hull, cylinder_hull, points_hull
 from kcplan.arm.kinematics import body_frames
+from kcplan.arm.pairs import prove_pairs
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.kernel import KernelArmCertifier
 from kcplan.world import ScenarioError, parse_scenario
@@ -171,3 +172,90 @@ def test_the_representation_is_a_checked_scenario_field():
     frames = body_frames(arm, np.zeros(7))
     assert frames.shape == (len(arm.bodies), 4, 4)
     assert ArmWorld(arm, ()).kernel.chain.n_hulls == len(arm.bodies)
+
+
+@pytest.fixture(scope="module")
+def panda_without_srdf():
+    """The Panda's hulls with no SRDF: every pair of links on different joints checked."""
+    return load_arm(PANDA / "panda.urdf", PANDA_GROUP)
+
+
+def test_pairs_proven_apart_never_touch_and_witnesses_do(panda_without_srdf):
+    """Every pair proven apart is apart at 3,000 random configurations within the limits
+    (python-fcl on the hulls: code that knows nothing of the proof), and every witness of
+    a touching pair is a configuration where python-fcl finds the pair in contact."""
+    import fcl
+
+    arm = panda_without_srdf
+    proofs = prove_pairs(arm)
+    verdicts = [p.verdict for p in proofs]
+    assert verdicts.count("apart") >= 10 and verdicts.count("touches") >= 20
+    alone = ArmWorld(arm, (), prove_pairs=False)
+    assert len(alone.self_pairs) == len(proofs) == 49
+    fewer = ArmWorld(arm, ())
+    assert fewer.proven_apart == verdicts.count("apart")
+    assert len(fewer.self_pairs) == 49 - fewer.proven_apart
+    apart = [p.bodies for p in proofs if p.verdict == "apart"]
+    states = np.random.default_rng(4).uniform(arm.lower, arm.upper, size=(3000, arm.dof))
+    request = fcl.DistanceRequest()
+    for q in states:
+        alone._place(q)
+        for i, j in apart:
+            d = fcl.distance(alone._bodies[i], alone._bodies[j], request, fcl.DistanceResult())
+            assert d > 0.0, (arm.bodies[i].link, arm.bodies[j].link, q)
+    for p in proofs:
+        if p.verdict == "touches":
+            assert arm.within_limits(p.witness)
+            alone._place(np.array(p.witness))
+            i, j = p.bodies
+            d = fcl.distance(alone._bodies[i], alone._bodies[j], request, fcl.DistanceResult())
+            assert d <= 1e-5, p
+
+
+def test_the_srdf_leaves_only_pairs_that_touch(panda):
+    """The MBM Panda's SRDF disables 28 of the 49 pairs; the 21 it leaves can all touch
+    (each with a witness), so no proof removes one of them."""
+    proofs = prove_pairs(panda)
+    assert len(proofs) == 21 and all(p.verdict == "touches" for p in proofs)
+
+
+def test_coal_distances_of_hulls_are_below_the_true_distance(panda, world, states):
+    """The kernel's certain clearances of hulls (coal's GJK less the allowance of
+    kcplan._kernel, COAL_CLEARANCE_RTOL and _ATOL) against an independent reference: the
+    largest separation of the two shapes' exact support functions over directions
+    (a lower bound of the distance at every direction, and the distance at the best),
+    taken along python-fcl's direction and, where that is short of the kernel's value,
+    maximised by scipy."""
+    from scipy.optimize import minimize
+
+    from kcplan.arm.world import _support
+    from kcplan.world.support import separation
+
+    def best_separation(a, b, start):
+        def negative(x):
+            return -separation(a, b, x / np.linalg.norm(x))
+
+        found = max(-minimize(negative, x0, method="Nelder-Mead",
+                              options={"xatol": 1e-12, "fatol": 1e-15, "maxiter": 4000}).fun
+                    for x0 in (start, *np.random.default_rng(0).normal(size=(4, 3))))  # fmt: skip
+        return found
+
+    def middle(support):  # the centre of a shape's bounding box, from its support
+        return np.array([support(e) - support(-e) for e in np.eye(3)]) / 2
+
+    measured = 0
+    for q in states[:120]:
+        k_scene, k_pairs = world.kernel.safe_clearances(q.tolist())
+        p_scene, p_pairs = world.clearances(q)
+        measured += int((p_scene > 0).sum() + (p_pairs > 0).sum())
+        frames = body_frames(panda, q)
+        for k in np.flatnonzero((p_scene > 0) & (np.array(k_scene) > p_scene)):
+            a = _support(panda.bodies[k], frames[k])
+            truth = min(best_separation(a, piece, middle(piece) - a.vertices.mean(0))
+                        for piece in world._supports)  # fmt: skip
+            assert k_scene[k] <= truth
+        for m in np.flatnonzero((p_pairs > 0) & (np.array(k_pairs) > p_pairs)):
+            i, j = world.self_pairs[m]
+            a, b = _support(panda.bodies[i], frames[i]), _support(panda.bodies[j], frames[j])
+            assert k_pairs[m] <= best_separation(a, b, b.vertices.mean(0) - a.vertices.mean(0))
+    assert measured > 1000

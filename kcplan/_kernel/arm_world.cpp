@@ -88,6 +88,8 @@ ArmWorld::ArmWorld(const Chain& chain, const std::vector<std::array<int, 2>>& pa
       runs_.back().end = m + 1;
   }
   scene_ = std::make_unique<World>(bodies_of(chain), 1.0, rtol, atol);
+  part_sizes_.assign(parts_.bodies().size(), 0);
+  for (int p : part_of_) ++part_sizes_[p];
   frames_.resize(chain.bodies().size());
   framed_.assign(chain.bodies().size(), 0);
   placed_.assign(chain.bodies().size(), 0);
@@ -147,6 +149,10 @@ void ArmWorld::scene_clearances(double* out, const double* caps) {
   for (std::size_t k = 0; k < part_of_.size(); ++k)
     part_caps_[part_of_[k]] = std::max(part_caps_[part_of_[k]], caps[k]);
   for (std::size_t p = 0; p < part_caps_.size(); ++p) {
+    if (part_sizes_[p] == 1) {  // the part's ball is its body's: ask the body alone
+      part_caps_[p] = 0.0;
+      continue;
+    }
     const coal::Vec3s& c = part_frames_[p].getTranslation();
     ++part_queries;
     const double d = scene_->ball_safe_clearance({c[0], c[1], c[2]}, parts_.bodies()[p].a_max,
@@ -267,7 +273,9 @@ bool ArmWorld::in_collision(const double* q) {
   part_caps_.assign(parts_.bodies().size(), -1.0);  // per part: -1 not asked, 0 apart, 1 touches
   for (std::size_t k = 0; k < part_of_.size(); ++k) {
     double& touches = part_caps_[part_of_[k]];
-    if (touches < 0.0) {
+    if (touches < 0.0 && part_sizes_[part_of_[k]] == 1) {
+      touches = 1.0;  // the part's ball is its body's: ask the body alone
+    } else if (touches < 0.0) {
       const coal::Vec3s& c = part_frames_[part_of_[k]].getTranslation();
       ++part_queries;
       touches = scene_->ball_touches({c[0], c[1], c[2]}, parts_.bodies()[part_of_[k]].a_max);

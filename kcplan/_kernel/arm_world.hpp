@@ -31,7 +31,8 @@ namespace kcplan {
 /// the other part's) each of its pairs', and the parts' speed bounds bound the bodies':
 /// queries and the certifier decide whole groups and runs that are far apart without
 /// looking at their pairs, and a part's bodies only when the part's ball is near the
-/// scene.
+/// scene (a part of one body, such as a link's hull, is asked as that body at once: its
+/// ball would be the body's own).
 ///
 /// Contract: a configuration has chain().dof() finite numbers (std::invalid_argument
 /// otherwise; limits are the certifier's business). Distances of safe_* queries are
@@ -133,6 +134,7 @@ class ArmWorld {
 
   Chain chain_;
   std::vector<int> part_of_;  // before parts_: parts_ is built from it
+  std::vector<int> part_sizes_;  // bodies per part: a part of one body needs no ball query
   Chain parts_;
   std::vector<std::array<int, 2>> pairs_, groups_;
   std::vector<int> group_of_;

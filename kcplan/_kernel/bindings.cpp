@@ -8,6 +8,7 @@
 
 #include "arm_certifier.hpp"
 #include "certifier.hpp"
+#include "pair_proof.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -380,6 +381,19 @@ NB_MODULE(_core, m) {
         std::fill(w.scene().body_query_counts.begin(), w.scene().body_query_counts.end(), 0);
         w.pair_queries = 0, w.part_queries = 0;
       });
+
+  m.def(
+      "prove_pairs_apart",
+      [](kcplan::ArmWorld& world, std::int64_t max_boxes) {
+        nb::list out;
+        static const char* names[] = {"apart", "touches", "unknown"};
+        for (const kcplan::PairProof& p : kcplan::prove_pairs_apart(world, max_boxes))
+          out.append(nb::make_tuple(names[p.verdict], p.boxes, p.least, p.witness));
+        return out;
+      },
+      "world"_a, "max_boxes"_a,
+      "(verdict, boxes, least clearance, witness) of each self pair of the world: "
+      "kcplan/_kernel/pair_proof.hpp");
 
   nb::class_<kcplan::ArmCertifier>(m, "ArmCertifier")
       .def(

@@ -13,20 +13,24 @@
 
 #include <coal/collision_object.h>
 #include <coal/data_types.h>
+#include <coal/shape/convex.h>
 #include <coal/shape/geometric_shapes.h>
 
 namespace kcplan {
 
 /// The support function h(n) = max over a robot-side shape of n . x: an ellipsoid
-/// {c + R diag(r) u : |u| <= 1} (a ball: r = (rho, rho, rho)) or a capsule (the points
-/// within rho of the segment c +- R e_z l). `spread_low <= h(n) - n . c <= spread_high`
-/// for every unit n.
+/// {c + R diag(r) u : |u| <= 1} (a ball: r = (rho, rho, rho)), a capsule (the points
+/// within rho of the segment c +- R e_z l) or a convex polytope (the hull of c + R v over
+/// its vertices v: an arm link's hull, ConvexBody). `spread_low <= h(n) - n . c <=
+/// spread_high` for every unit n.
 struct ShapeSupport {
   coal::Vec3s centre = coal::Vec3s::Zero();
   coal::Matrix3s M = coal::Matrix3s::Zero();  // ellipsoid: diag(r) R^T, so h = n.c + |M n|
   coal::Vec3s half_segment = coal::Vec3s::Zero();  // capsule: R e_z l
   double radius = 0.0;                             // capsule: rho
   bool capsule = false;
+  const std::vector<coal::Vec3s>* hull = nullptr;  // polytope: its vertices v
+  coal::Matrix3s rotation = coal::Matrix3s::Identity();  // polytope: R
   double spread_low = 0.0, spread_high = 0.0;
 
   /// The support of `object`'s shape at its transform; false for any other shape.
@@ -35,6 +39,7 @@ struct ShapeSupport {
     const coal::CollisionGeometry* g = object.collisionGeometryPtr();
     out.centre = tf.getTranslation();
     out.capsule = false;
+    out.hull = nullptr;
     if (const auto* e = dynamic_cast<const coal::Ellipsoid*>(g)) {
       out.M = e->radii.asDiagonal() * tf.getRotation().transpose();
       out.spread_low = e->radii.minCoeff(), out.spread_high = e->radii.maxCoeff();
@@ -52,15 +57,37 @@ struct ShapeSupport {
       out.spread_low = c->radius, out.spread_high = c->radius + c->halfLength;
       return true;
     }
+    if (const auto* h = dynamic_cast<const coal::ConvexBase*>(g)) {
+      // |v| <= |aabb centre| + the local box's half diagonal (coal's aabb_radius), so
+      // |h(n) - n . c| <= that bound whatever the frame's origin is
+      out.hull = h->points.get();
+      out.rotation = tf.getRotation();
+      out.spread_high = (h->aabb_center.norm() + h->aabb_radius) * (1.0 + 1e-12);
+      out.spread_low = -out.spread_high;
+      return true;
+    }
     return false;
   }
 
   /// h(n) - n . c.
   double spread(const coal::Vec3s& n) const {
+    if (hull != nullptr) return (*hull)[extreme_vertex(n)].dot(rotation.transpose() * n);
     return capsule ? std::abs(n.dot(half_segment)) + radius : (M * n).norm();
+  }
+  /// A polytope's vertex where (R v) . n is largest.
+  std::size_t extreme_vertex(const coal::Vec3s& n) const {
+    const coal::Vec3s local = rotation.transpose() * n;
+    std::size_t best = 0;
+    double most = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < hull->size(); ++i) {
+      const double h = (*hull)[i].dot(local);
+      if (h > most) most = h, best = i;
+    }
+    return best;
   }
   /// A point of the shape where n . x = h(n).
   coal::Vec3s extreme_point(const coal::Vec3s& n) const {
+    if (hull != nullptr) return centre + rotation * (*hull)[extreme_vertex(n)];
     if (capsule)
       return centre + (n.dot(half_segment) >= 0.0 ? half_segment : coal::Vec3s(-half_segment)) +
              radius * n;

@@ -20,8 +20,9 @@ namespace kcplan {
 /// (radius, radius, half height) about its local z axis.
 ///
 /// Proof of the bound (`separation`): for any unit n, every point x of a convex shape S
-/// has n . x >= n . c - spread_S(n) (ShapeSupport) and every point y of the obstacle B
-/// has n . y <= h_B(n), so |x - y| >= n . (x - y) >= n . c - spread_S(n) - h_B(n): the
+/// has n . x >= -h_S(-n) = n . c - spread_S(-n) (ShapeSupport; spread_S(-n) = spread_S(n)
+/// for a centrally symmetric S, not for a polytope) and every point y of the obstacle B
+/// has n . y <= h_B(n), so |x - y| >= n . (x - y) >= n . c - spread_S(-n) - h_B(n): the
 /// separation along n is a lower bound of dist(S, B), whichever n is taken. n from the
 /// point of B nearest S's centre c towards c makes it tight where S is a ball (it is
 /// then the distance itself) and close for a thin ellipsoid beside a bar. Rounding is of
@@ -96,7 +97,7 @@ struct Primitive {
     const double length = d.norm();
     if (!(length > 0.0) || !std::isfinite(length)) return kUnknown;
     const coal::Vec3s n = d / length;
-    const double gap = n.dot(c) - shape.spread(n) - support(n);
+    const double gap = n.dot(c) - shape.spread(-n) - support(n);
     const double scale = 1.0 + c.norm() + centre.norm() + size.norm() + shape.spread_high;
     exact = !shape.capsule && shape.spread_low == shape.spread_high;
     return gap - 1e-12 * scale;

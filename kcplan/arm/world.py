@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from kcplan._kernel import build_kernel_arm
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import ArmModel
+from kcplan.arm.pairs import prove_pairs as prove_pairs_of
 from kcplan.world.collision import CLEARANCE_ATOL, CLEARANCE_RTOL, fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
 from kcplan.world.support import EllipsoidSupport, PointsSupport, piece_supports, separation
@@ -71,6 +72,9 @@ class ArmWorld:
     allowed : collection of frozenset of str, optional
         Link pairs allowed to touch (a scene's allowed collision matrix): their bodies
         are not checked against each other.
+    prove_pairs : bool, optional
+        Leave out the self pairs proven apart over the whole joint box
+        (:mod:`kcplan.arm.pairs`, once per arm); False checks them all (the ablation).
 
     Notes
     -----
@@ -85,12 +89,21 @@ class ArmWorld:
         obstacles: Sequence[Obstacle] = (),
         size: float | None = None,
         allowed: Collection[frozenset] = (),
+        prove_pairs: bool = True,
     ):
         self.arm = arm
         self.obstacles = tuple(obstacles)
         self.allowed = frozenset(allowed)
-        self.self_pairs = checked_pairs(arm, self.allowed)
-        """The pairs of :attr:`ArmModel.self_pairs` whose links are not allowed to touch."""
+        pairs = checked_pairs(arm, self.allowed)
+        self.proven_apart = 0
+        """How many of those pairs were left out, proven apart (:mod:`kcplan.arm.pairs`)."""
+        if prove_pairs and len(pairs):
+            keep = [p.verdict != "apart" for p in prove_pairs_of(arm, pairs)]
+            self.proven_apart = len(pairs) - sum(keep)
+            pairs = pairs[np.array(keep, dtype=bool)]
+        self.self_pairs = pairs
+        """The pairs of :attr:`ArmModel.self_pairs` whose links are not allowed to touch
+        and that are not proven apart."""
         self._shapes = [_fcl_shape(b) for b in arm.bodies]
         self._bodies = [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
         self._objects, self._supports, boxes = [], [], []
