@@ -23,10 +23,12 @@ edges each step rejects (the price of proving, partly the cover's). Progress lin
 stderr; a Markdown table on stdout::
 
     python scripts/arm_soundness.py [--robot panda] [--edges 100000] [--seed 1]
-        [--per-class 100] [--bodies 2] [--max-offset D] [--twin 0] [--free-check 0.05]
+        [--per-class 100] [--representation R] [--bodies 2] [--max-offset D] [--twin 0]
+        [--free-check 0.05]
         [--kc-inflation 0.2]
 
-The arm's links are covered by ``--bodies`` ellipsoids each (2 by default: fast to fit
+The arm's links are each their own convex hull with ``--representation hulls`` (kcplan's
+default), else covered by ``--bodies`` ellipsoids each (2 by default: fast to fit
 and to check), or with ``--max-offset D`` as :func:`kcplan.arm.load_arm` covers them by
 default (``D = 0.01``: hundreds of bodies, a cold fit of about 20 minutes).
 """
@@ -97,7 +99,8 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
     fixed = {k: v for k, v in chosen[0].start_state.items() if k not in joints}
     arm = load_arm(folder / f"{args.robot}.urdf", joints, srdf=folder / f"{args.robot}.srdf",
                    fixed=_known(folder / f"{args.robot}.urdf", fixed),
-                   bodies_per_link=args.bodies, max_offset=args.max_offset)  # fmt: skip
+                   bodies_per_link=args.bodies, max_offset=args.max_offset,
+                   representation=args.representation)  # fmt: skip
     print(f"{len(chosen)} problems, {arm.describe()}, {len(arm.self_pairs)} self pairs, "
           f"ready in {time.perf_counter() - t0:.1f} s", file=out, flush=True)  # fmt: skip
     c = {"edges": 0, "accepted": 0, "violations": 0, "verified": 0, "twin": 0,
@@ -194,6 +197,9 @@ def main(argv: list[str] | None = None) -> int:
         "--max-offset", type=float, default=None,
         help="metres a link's cover may stick out of its mesh (as load_arm)",
     )  # fmt: skip
+    parser.add_argument("--representation", choices=("hulls", "ellipsoids"), default=None,
+                        help="the links' bodies (default: ellipsoids; hulls: kcplan's "
+                        "default, each link its own convex hull)")  # fmt: skip
     parser.add_argument("--twin", type=int, default=0, help="edges also decided in Python")
     parser.add_argument("--free-check", type=float, default=0.05,
                         help="fraction of rejected edges verified on the meshes")  # fmt: skip
@@ -201,7 +207,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="the KC guards' inflation (0: the clearance balls alone)")  # fmt: skip
     parser.add_argument("--mbm", default=os.fspath(MBM), help="folder of the MBM robots")
     args = parser.parse_args(argv)
-    if args.bodies is None and args.max_offset is None:
+    if args.bodies is None and args.max_offset is None and args.representation != "hulls":
         args.bodies = 2
     if args.edges < 1 or args.per_class < 1 or not 0.0 <= args.free_check <= 1.0:
         parser.error("expected --edges >= 1, --per-class >= 1, 0 <= --free-check <= 1")

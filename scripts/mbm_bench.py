@@ -27,7 +27,7 @@ planning time in milliseconds::
 
     python scripts/mbm_bench.py [--robot panda|ur5] [--per-class 20] [--classes box,cage]
         [--planners kc-rrtconnect,rrtconnect,...] [--time 10] [--representation R]
-        [--bodies-per-link K] [--max-offset D] [--vamp-python PY] [-o DIR]
+        [--bodies-per-link K] [--max-offset D] [--jobs J] [--vamp-python PY] [-o DIR]
 
 A shared, loaded machine makes the times indicative; the counts are what they are.
 """
@@ -101,6 +101,7 @@ def run_bench(args: argparse.Namespace, files: list[Path], folder: Path) -> list
     command = [sys.executable, "-m", "kcplan.cli", "bench", *map(os.fspath, files),
                "--planners", args.planners, "--runs", "1", "--seed", str(args.seed),
                "--time", str(args.time), "--no-simplify", "--progress-interval", "0",
+               "--jobs", str(args.jobs),
                "-o", os.fspath(folder), "--force"]  # fmt: skip
     subprocess.run(command, check=True, cwd=ROOT)
     with open(folder / "summary.csv", newline="") as f:
@@ -165,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--planners", default=PLANNERS, help=f"default {PLANNERS}")
     parser.add_argument("--time", type=float, default=10.0, help="seconds per solve")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--jobs", type=int, default=1, help="runs at once (kcplan bench)")
     parser.add_argument(
         "--representation",
         choices=("hulls", "ellipsoids"),

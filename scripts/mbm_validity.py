@@ -6,7 +6,8 @@ twice: for the arm covered by ``--bodies`` ellipsoids per link
 (:class:`kcplan.arm.ArmWorld`, what a certifier plans with) and for the links' own
 collision meshes (:func:`kcplan.arm.verify.verify_arm_path` at the one state), both with
 the scene's allowed collision matrix. A state valid on the meshes but not for the cover
-is one the cover makes unreachable. Covers: ``--bodies K,...`` (exactly K per link, the
+is one the cover makes unreachable. Representations: ``--hulls`` (each link its own convex
+hull, kcplan's default, :mod:`kcplan.arm.hulls`), ``--bodies K,...`` (exactly K per link, the
 smallest union) and ``--max-offset D,...`` (metres: as many per link as it takes to
 stick out by at most D, :func:`kcplan.arm.load_arm`; ``default`` is
 :data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`). Prints a Markdown table, one line per cover
@@ -15,7 +16,7 @@ sticks out of its mesh (mm: the fit's proved bound for ``--max-offset`` covers, 
 sampled estimate :func:`kcplan.cover.offset.cover_offsets` for ``--bodies`` ones) and
 how many bodies it has::
 
-    python scripts/mbm_validity.py [--per-class 100] [--bodies 1,2] [--max-offset default]
+    python scripts/mbm_validity.py [--per-class 100] [--hulls] [--bodies 1,2] [--max-offset default]
         [--most K] [--offsets]
 """
 
@@ -44,6 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--urdf", default=os.fspath(PANDA / "panda.urdf"))
     parser.add_argument("--srdf", default=os.fspath(PANDA / "panda.srdf"))
     parser.add_argument("--per-class", type=int, default=100)
+    parser.add_argument("--hulls", action="store_true", help="each link its own convex hull")
     parser.add_argument("--bodies", default="", help="bodies per link, comma-separated")
     parser.add_argument("--max-offset", default="", help="metres (or 'default'), comma-separated")
     parser.add_argument(
@@ -58,23 +60,29 @@ def main(argv: list[str] | None = None) -> int:
     if len(groups) != 1:
         parser.error(f"archive: expected one planning group, got {sorted(groups)}")
     (joints,) = groups
-    covers = [(b, None) for b in (int(k) for k in args.bodies.split(",") if k)]
+    covers = [("hulls", None, None)] if args.hulls else []
+    covers += [("ellipsoids", b, None) for b in (int(k) for k in args.bodies.split(",") if k)]
     for text in (t for t in args.max_offset.split(",") if t):
-        covers.append((args.most, DEFAULT_MAX_OFFSET if text == "default" else float(text)))
+        offset = DEFAULT_MAX_OFFSET if text == "default" else float(text)
+        covers.append(("ellipsoids", args.most, offset))
     if not covers:
-        parser.error("expected --bodies or --max-offset")
+        parser.error("expected --hulls, --bodies or --max-offset")
     print("| cover | class | problems | starts valid: cover / meshes | "
           "goals valid: cover / meshes | lost to the cover |")  # fmt: skip
     print("|---|---|---|---|---|---|")
     arms, notes = [], []
-    for bodies, max_offset in covers:
+    for representation, bodies, max_offset in covers:
         t0 = time.perf_counter()
         arm = load_arm(args.urdf, joints, srdf=args.srdf, bodies_per_link=bodies,
-                       max_offset=max_offset, progress=_fitted)  # fmt: skip
+                       max_offset=max_offset, progress=_fitted,
+                       representation=representation)  # fmt: skip
         label = f"{bodies}" if max_offset is None else f"<= {1000 * max_offset:g} mm"
         if max_offset is not None and bodies is not None:
             label += f", at most {bodies}"
-        arms.append((label, bodies, max_offset, arm))
+        if representation == "hulls":
+            label = "hulls"
+        else:
+            arms.append((label, bodies, max_offset, arm))
         notes.append(f"{label}: {len(arm.bodies)} bodies, {len(arm.self_pairs)} self pairs, "
                      f"loaded in {time.perf_counter() - t0:.1f} s")  # fmt: skip
         totals = [0, 0, 0, 0, 0, 0]

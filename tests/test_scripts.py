@@ -128,9 +128,10 @@ CASES = [
     ),
     Case(
         "mbm_validity.py",
-        ("--per-class", "1", "--bodies", "1", "--offsets"),
+        ("--per-class", "1", "--hulls", "--bodies", "1", "--offsets"),
         (
             r"^700 problems read in ",
+            r"^\| hulls \| box \| 1 \| 1 / 1 \| 1 / 1 \| 0 \|$",
             r"^\| panda_hand_0 \| [1-9]\d* \|$",
             r"^\| 1 \| box \| 1 \| [01] / 1 \| [01] / 1 \| [012] \|$",
             r"^\| 1 \| all \| 7 \| \d / 7 \| \d / 7 \| \d+ \|$",
