@@ -86,7 +86,7 @@ def test_an_arm_scenario_is_read(scenario_file):
         (
             {"goal": {"joints": [0.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0]}},
             r"goal.joints: expected joint values within the URDF's limits, got panda_joint4 "
-            r"0.5 not in \[-3.142, 0.0873\]",
+            r"0.5 > 0.0873",
         ),
         (
             {"obstacles": [{"cylinder": {"center": [0, 0, 0], "radius": -1, "height": 1}}]},
@@ -239,3 +239,23 @@ def test_the_rigid_world_refuses_arms_with_one_line(capsys):
         CollisionWorld(box)
     assert main(["validate", str(box)]) == 0
     assert "robot arm of 7 joints, 11 bodies (panda.urdf)" in capsys.readouterr().out
+
+
+def test_a_state_a_hair_outside_a_limit_is_clamped_and_said_once(scenario_file, capsys):
+    """Issue 39: a value within LIMIT_TOLERANCE of a limit (data sets write pi where the
+    URDF writes 3.14159) is moved onto the limit and reported once; farther out, the error
+    shows every digit of the value and of the limit."""
+    from kcplan.arm.model import LIMIT_TOLERANCE
+
+    upper = 0.0873  # panda_joint4's upper limit in the bundled URDF
+    near = [0.0, -0.3, 0.0, upper + 0.5 * LIMIT_TOLERANCE, 0.0, 1.6, 0.785]
+    scenario = load_scenario(scenario_file(goal={"joints": near}))
+    assert scenario.goal[3] == upper and scenario.goal.tolist()[:3] == near[:3]
+    err = capsys.readouterr().err
+    assert err.count("clamped") == 1
+    said = f"goal.joints: clamped to the URDF's limits (within 1e-05): panda_joint4 {near[3]!r}"
+    assert f"{said} -> 0.0873" in err
+    far = [*near[:3], upper + 2 * LIMIT_TOLERANCE, *near[4:]]
+    path = scenario_file(goal={"joints": far})
+    assert main(["plan", str(path)]) == 2
+    assert f"got panda_joint4 {far[3]!r} > 0.0873" in capsys.readouterr().err

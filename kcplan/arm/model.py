@@ -56,6 +56,7 @@ from kcplan.geometry.robot import MAX_BODIES
 
 __all__ = [
     "DEFAULT_MAX_OFFSET",
+    "LIMIT_TOLERANCE",
     "REPRESENTATIONS",
     "JOINT_KINDS",
     "ArmBody",
@@ -78,6 +79,12 @@ the hand stop at :data:`kcplan.cover.fit.MAX_OFFSET_BODIES` bodies, 12-21 mm out
 13,056 self pairs, against 44 and 336 for 4 bodies per link, and about 20 minutes to fit
 once (cached). With at most 16 bodies per link: 148 bodies, 3,584 self pairs, 655 of 700
 goals."""
+
+LIMIT_TOLERANCE = 1e-5
+"""How far (radians, or metres for a prismatic joint) a start or goal may lie outside a
+joint limit and still be taken, clamped to the limit (:meth:`ArmModel.clamp`): data sets
+write a joint at pi where the URDF's limit is 3.14159 (MotionBenchMaker's mobile
+manipulator: 2.7e-6 outside), and MoveIt accepts such a state within its bounds margin."""
 
 REPRESENTATIONS = ("hulls", "ellipsoids")
 """How links are represented (module docstring); the first is the default."""
@@ -191,6 +198,36 @@ class ArmModel:
         q = np.zeros(self.dof)
         q[self.q_index] = state
         return q
+
+    def clamp(
+        self, q: Sequence[float], tolerance: float = LIMIT_TOLERANCE
+    ) -> tuple[NDArray[np.float64], list[str], list[str]]:
+        """``q`` (shape ``(dof,)``, finite) with every value within ``tolerance`` outside
+        its joint's limits moved onto the limit.
+
+        Returns
+        -------
+        q : ndarray, shape (dof,)
+            The clamped values.
+        clamped : list of str
+            One entry per value moved: ``NAME VALUE -> LIMIT``, every digit shown.
+        outside : list of str
+            One entry per value farther out: ``NAME VALUE > UPPER`` (or ``< LOWER``), with
+            the digits that show the difference (``3.141592653589793 > 3.14159``).
+        """
+        q = np.array(q, dtype=float)
+        clamped, outside = [], []
+        for j, (name, lo, hi) in enumerate(zip(self.joints, self.lower, self.upper, strict=True)):
+            v = float(q[j])
+            for beyond, limit, sign in ((v > hi, float(hi), ">"), (v < lo, float(lo), "<")):
+                if not beyond:
+                    continue
+                if abs(v - limit) <= tolerance:
+                    clamped.append(f"{name} {v!r} -> {limit!r}")
+                    q[j] = limit
+                else:
+                    outside.append(f"{name} {v!r} {sign} {limit!r}")
+        return q, clamped, outside
 
     def within_limits(self, q: Sequence[float]) -> bool:
         """Whether ``q`` (shape ``(dof,)``) is finite and inside the joint limits."""

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.model import REPRESENTATIONS, ArmError, ArmModel, load_arm
+from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
 from kcplan.world.scenario import (
     MAX_OBSTACLES,
     Obstacle,
@@ -93,14 +93,13 @@ def _cylinder(r: _Reader, spec: Any, index: int) -> Obstacle:
 def _joints(r: _Reader, value: Any, where: str, arm: ArmModel) -> NDArray[np.float64]:
     spec = r.mapping(value, where, ("joints",))
     q = r.vector(spec["joints"], f"{where}.joints", arm.dof)
-    if not arm.within_limits(q):
-        outside = [
-            f"{name} {v:.4g} not in [{lo:.4g}, {hi:.4g}]"
-            for name, v, lo, hi in zip(arm.joints, q, arm.lower, arm.upper, strict=True)
-            if not lo <= v <= hi
-        ]
+    q, clamped, outside = arm.clamp(q)
+    if outside:
         r.fail(f"{where}.joints", "joint values within the URDF's limits", q.tolist(),
                "; ".join(outside))  # fmt: skip
+    if clamped:  # said once, on stderr: the plan starts or ends on the limit
+        line = f"{where}.joints: clamped to the URDF's limits (within {LIMIT_TOLERANCE:g})"
+        print(f"kcplan: {r.source}: {line}: {'; '.join(clamped)}", file=sys.stderr, flush=True)
     return q
 
 
