@@ -259,3 +259,74 @@ def test_coal_distances_of_hulls_are_below_the_true_distance(panda, world, state
             a, b = _support(panda.bodies[i], frames[i]), _support(panda.bodies[j], frames[j])
             assert k_pairs[m] <= best_separation(a, b, b.vertices.mean(0) - a.vertices.mean(0))
     assert measured > 1000
+
+
+def _package_robot(tmp_path):
+    """A one-link URDF whose mesh is ``package://mypkg/meshes/link.obj``, the package in
+    ``tmp_path / "pkgs"`` (the Panda's link1 mesh)."""
+    import shutil
+
+    meshes = tmp_path / "pkgs" / "mypkg" / "meshes"
+    meshes.mkdir(parents=True)
+    shutil.copy(PANDA / "meshes" / "collision" / "link1.obj", meshes / "link.obj")
+    urdf = tmp_path / "robot" / "one.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(
+        "<robot name='one'><link name='base'/><link name='arm'><collision><geometry>"
+        "<mesh filename='package://mypkg/meshes/link.obj'/></geometry></collision></link>"
+        "<joint name='j' type='revolute'><parent link='base'/><child link='arm'/>"
+        "<axis xyz='0 0 1'/><limit lower='-1' upper='1' effort='1' velocity='1'/></joint>"
+        "</robot>"
+    )
+    return urdf, tmp_path / "pkgs"
+
+
+def test_package_uris_resolve_as_ros_does(tmp_path, monkeypatch):
+    """Issue 39: package:// meshes are found in package_dirs, in ROS_PACKAGE_PATH and in a
+    scenario's robot.package_dirs; a mesh found nowhere is one line naming it."""
+    from kcplan.arm import ArmError
+
+    urdf, packages = _package_robot(tmp_path)
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    with pytest.raises(ArmError, match=r"one\.urdf: collision: expected the mesh "
+                       r"package://mypkg/meshes/link\.obj in a package folder \("):  # fmt: skip
+        load_arm(urdf, ["j"])
+    assert len(load_arm(urdf, ["j"], package_dirs=[packages]).bodies) == 1
+    monkeypatch.setenv("ROS_PACKAGE_PATH", f"/nowhere:{packages}")
+    assert len(load_arm(urdf, ["j"]).bodies) == 1
+    monkeypatch.delenv("ROS_PACKAGE_PATH")
+    data = {
+        "name": "p", "robot": {"urdf": "robot/one.urdf", "joints": ["j"], "package_dirs": ["pkgs"]},
+        "start": {"joints": [0.0]}, "goal": {"joints": [0.5]},
+    }  # fmt: skip
+    assert len(parse_scenario(data, "p.yaml", tmp_path, check=False).arm.bodies) == 1
+    data["robot"]["package_dirs"] = ["missing"]
+    with pytest.raises(ScenarioError, match="robot.package_dirs: expected existing folders"):
+        parse_scenario(data, "p.yaml", tmp_path, check=False)
+
+
+def test_without_an_srdf_joined_links_may_touch(panda_without_srdf):
+    """Issue 39: with no SRDF the links joined by a joint are not checked (9 of the Panda's
+    49 pairs of links on different joints), every other pair is."""
+    pairs = {frozenset((panda_without_srdf.bodies[i].link, panda_without_srdf.bodies[j].link))
+             for i, j in panda_without_srdf.self_pairs}  # fmt: skip
+    assert len(pairs) == 40
+    for a, b in (("panda_link1", "panda_link2"), ("panda_link6", "panda_link7"),
+                 ("panda_link0", "panda_link1"), ("panda_hand", "panda_leftfinger")):  # fmt: skip
+        assert frozenset((f"{a}", f"{b}")) not in pairs
+    assert frozenset(("panda_link2", "panda_link6")) in pairs
+
+
+def test_robot_info_describes_an_arm(capsys):
+    from kcplan.cli import main
+
+    urdf, srdf = PANDA / "panda.urdf", PANDA / "panda.srdf"
+    assert main(["robot", "info", str(urdf), "--srdf", str(srdf)]) == 0
+    out = capsys.readouterr().out
+    assert "7 joints in the group, 11 bodies (links as their convex hulls)" in out
+    assert "  panda_joint4: revolute [-3.1416, 0.0873]" in out
+    assert "  panda_link6: hull of 260 vertices" in out
+    assert "self pairs the SRDF leaves: 21; proven apart 0 (never checked), can touch 21" in out
+    assert main(["robot", "info", str(urdf), "--joints", "panda_joint1", "nope"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "joints: 'nope' is not a joint of the URDF" in err

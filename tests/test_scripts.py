@@ -307,6 +307,17 @@ CASES.append(
 )
 
 CASES.append(
+    Case(
+        "pair_proofs.py",
+        ("--robot", "panda", "--max-boxes", "400"),
+        (
+            r"^\| robot \| links \| pairs \(no SRDF\) \| proven apart \| touch \| unknown ",
+            r"^\| panda \| 11 \| 40 \| \d+ \| \d+ \| \d+ \| 21 \| 0 \| 19 \| [01] \| [\d.]+ \|$",
+        ),
+    )
+)
+
+CASES.append(
     Case(  # the 4-body cover: the bundled scenarios' (arm_edge_cost.py's case fits it first)
         "mbm_bench.py",
         ("--per-class", "1", "--classes", "table_pick", "--bodies-per-link", "4")

@@ -20,6 +20,7 @@ from __future__ import annotations
 import io
 import os
 import tarfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -251,16 +252,21 @@ def mbm_scenario(
     bodies_per_link: int | None = None,
     max_offset: float | None = None,
     representation: str | None = None,
+    package_dirs: Sequence[str | os.PathLike] = (),
 ) -> dict:
     """The arm scenario (:mod:`kcplan.arm.scenario`, as plain data) of one problem: its
     obstacles, start and goal for the goal's joints, every other joint of the URDF fixed
     at its start value, and the allowed collision matrix; robot paths relative to the
     folder of ``output``. ``representation``, ``bodies_per_link`` and ``max_offset``
     (metres) choose the links' bodies as the scenario's fields of those names do; all
-    None: kcplan's default, each link its own convex hull (:mod:`kcplan.arm.hulls`)."""
+    None: kcplan's default, each link its own convex hull (:mod:`kcplan.arm.hulls`).
+    ``package_dirs`` (folders of ``package://`` URIs) are written relative to the folder
+    of ``output``."""
     import pinocchio as pin
 
     folder = Path(output).resolve().parent
+    if not Path(urdf).is_file():
+        raise MbmError(f"{os.fspath(urdf)}: urdf: expected an existing URDF file")
     model = pin.buildModelFromUrdf(os.fspath(urdf))
     fixed = {
         joint: value
@@ -271,6 +277,8 @@ def mbm_scenario(
     if srdf is not None:
         robot["srdf"] = os.path.relpath(Path(srdf).resolve(), folder)
     robot["joints"] = list(problem.joints)
+    if package_dirs:
+        robot["package_dirs"] = [os.path.relpath(Path(d).resolve(), folder) for d in package_dirs]
     if representation is not None:
         robot["representation"] = str(representation)
     if bodies_per_link is not None:

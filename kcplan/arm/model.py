@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -64,6 +65,7 @@ __all__ = [
     "ArmModel",
     "load_arm",
     "mesh_cover",
+    "package_folders",
 ]
 
 DEFAULT_MAX_OFFSET = 0.01
@@ -257,12 +259,15 @@ def load_arm(
     ----------
     urdf : path-like
         The robot's URDF; mesh paths ``package://...`` resolve against ``package_dirs``
-        (default: the URDF's folder).
+        and the usual folders (:func:`package_folders`).
     joints : sequence of str
         The planning group, in state order: revolute or prismatic joints of the URDF,
         each named once.
     srdf : path-like, optional
-        Its ``disable_collisions`` pairs are never checked for self-collision.
+        Its ``disable_collisions`` pairs are never checked for self-collision. Without
+        one, links joined by a joint may touch (as MoveIt's setup assistant marks them
+        "Adjacent"; links fixed to each other count as one) and every other pair is
+        checked, or proven apart (:mod:`kcplan.arm.pairs`).
     fixed : mapping of str to float, optional
         Values of joints outside the group (default 0, or the nearest limit when 0 lies
         outside them).
@@ -271,6 +276,9 @@ def load_arm(
         union's volume (:func:`kcplan.cover.cache.cached_cover`). With ``max_offset``:
         the most per mesh (default :data:`kcplan.cover.fit.MAX_OFFSET_BODIES`).
     package_dirs : sequence of path-like, optional
+        Folders that hold the packages of ``package://PACKAGE/...`` mesh URIs (each
+        ``PACKAGE`` is a subfolder of one); :func:`package_folders` adds the URDF's folder,
+        ``ROS_PACKAGE_PATH`` and example-robot-data's share folder.
     progress : callable, optional
         Called with one line per mesh covered (fitted or from the cache, how long it
         took, how far it sticks out, and the fit's note when it hit the most bodies).
@@ -316,7 +324,7 @@ def load_arm(
         raise ArmError(f"{source}: max_offset: expected a positive number, got {max_offset!r}")
     if not Path(source).is_file():
         raise ArmError(f"{source}: urdf: expected a URDF file, found none")
-    dirs = [os.fspath(d) for d in (package_dirs or [Path(source).parent])]
+    dirs = package_folders(source, package_dirs)
     try:
         full = pin.buildModelFromUrdf(source)
         full_geometry = pin.buildGeomFromUrdf(
@@ -324,6 +332,13 @@ def load_arm(
         )
     except (RuntimeError, ValueError, OSError) as err:
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        missing = re.search(r"Mesh (\S+) could not be found", first)
+        if missing:
+            raise ArmError(
+                f"{source}: collision: expected the mesh {missing.group(1)} in a package folder "
+                f"({', '.join(dirs)}), found none: name the folder that holds its package in "
+                "robot.package_dirs (--package-dir) or ROS_PACKAGE_PATH"
+            ) from None
         raise ArmError(f"{source}: urdf: expected a readable URDF, got: {first}") from None
     group = _group(full, joints, source)
     fixed = dict(fixed or {})
@@ -366,6 +381,12 @@ def load_arm(
             raise ArmError(
                 f"{os.fspath(srdf)}: srdf: expected a readable SRDF, got: {err}"
             ) from None
+    else:  # as MoveIt's setup assistant marks them: links joined by a joint may touch
+        for pair in list(full_geometry.collisionPairs):
+            a = full_geometry.geometryObjects[pair.first].parentJoint
+            b = full_geometry.geometryObjects[pair.second].parentJoint
+            if full.parents[a] == b or full.parents[b] == a:
+                full_geometry.removeCollisionPair(pair)
     model, geometry = pin.buildReducedModel(full, full_geometry, locked, q_fixed)
     if len(geometry.geometryObjects) == 0:
         raise ArmError(f"{source}: collision: expected links with collision geometry, got none")
@@ -392,6 +413,27 @@ def load_arm(
         model, geometry, tuple(group), q_index, np.array(lower), np.array(upper), kinds,
         tuple(bodies), self_pairs, source, "" if srdf is None else os.fspath(srdf),
     )  # fmt: skip
+
+
+def package_folders(
+    urdf: str | os.PathLike, given: Sequence[str | os.PathLike] | None = None
+) -> list[str]:
+    """Where ``package://PACKAGE/...`` URIs of ``urdf`` are looked for, in order, as ROS
+    does: the ``given`` folders, the URDF's own folder, every folder of
+    ``ROS_PACKAGE_PATH``, and the ``share`` folder of the cmeel prefix that holds
+    Pinocchio (where PyPI's ``example-robot-data`` installs ``example-robot-data/...``).
+    Folders that do not exist are left out."""
+    import pinocchio as pin
+
+    folders = [os.fspath(d) for d in given or ()]
+    folders.append(os.fspath(Path(urdf).resolve().parent))
+    folders += [d for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
+    folders.append(os.fspath(Path(pin.__file__).resolve().parents[4] / "share"))
+    out: list[str] = []
+    for folder in folders:
+        if Path(folder).is_dir() and folder not in out:
+            out.append(folder)
+    return out
 
 
 def _group(full, joints: Sequence[str], source: str) -> list[str]:

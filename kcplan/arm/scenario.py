@@ -5,7 +5,8 @@ The format (``scenarios/README.md``)::
     name: box_1
     robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,
             joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
-            representation: hulls, bodies_per_link: K, max_offset: E, inflation: 0.0}
+            package_dirs: [DIR], representation: hulls, bodies_per_link: K,
+            max_offset: E, inflation: 0.0}
     start: {joints: [...]}            # the group's values, in ``joints`` order
     goal: {joints: [...]}
     obstacles: [{box: {center, size, quaternion}}, {cylinder: {center, quaternion,
@@ -13,7 +14,10 @@ The format (``scenarios/README.md``)::
                  {mesh: ...}]
     allowed: [[LINK, LINK], ...]      # link pairs allowed to touch (MoveIt's ACM)
 
-Paths are relative to the scenario file. ``joints`` is the planning group in state
+Paths are relative to the scenario file. ``package_dirs`` are folders that hold the
+packages of the URDF's ``package://PACKAGE/...`` mesh URIs, searched before the URDF's
+folder, ``ROS_PACKAGE_PATH`` and example-robot-data's share folder
+(:func:`kcplan.arm.model.package_folders`). ``joints`` is the planning group in state
 order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`).
 ``representation`` is ``hulls`` (each link its own convex hull, the default) or
 ``ellipsoids`` (covers; the default when ``bodies_per_link`` or ``max_offset`` is given).
@@ -124,7 +128,8 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
     spec = r.mapping(
         top["robot"], "robot", ("urdf", "joints"),
-        ("srdf", "fixed", "representation", "bodies_per_link", "max_offset", "inflation"),
+        ("srdf", "fixed", "package_dirs", "representation", "bodies_per_link", "max_offset",
+         "inflation"),
     )  # fmt: skip
     urdf = directory / r.text(spec["urdf"], "robot.urdf")
     srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
@@ -135,6 +140,14 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     joints = spec["joints"]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         r.fail("robot.joints", "a list of joint names", joints)
+    folders = spec.get("package_dirs", [])
+    if not isinstance(folders, list) or not all(isinstance(d, str) for d in folders):
+        r.fail("robot.package_dirs", "a list of folders (relative to the scenario)", folders)
+    package_dirs = [directory / d for d in folders]
+    for d, path in zip(folders, package_dirs, strict=True):
+        if not path.is_dir():
+            r.fail("robot.package_dirs", "existing folders (relative to the scenario)", None,
+                   f"{d!r}, which is not a folder at {path}")  # fmt: skip
     fixed = spec.get("fixed", {}) or {}
     if not isinstance(fixed, dict):
         r.fail("robot.fixed", "a mapping of joint names to values", fixed)
@@ -159,7 +172,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     try:
         arm = load_arm(
             urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice,
-            max_offset=max_offset, representation=representation,
+            max_offset=max_offset, representation=representation, package_dirs=package_dirs,
         )  # fmt: skip
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None

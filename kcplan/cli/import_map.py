@@ -76,7 +76,7 @@ def _run_mbm(args: argparse.Namespace, out: Path) -> int:
                 raise InputError(f"{path}: {option}: expected an existing file")
         data = mbm_scenario(
             problem, name, args.urdf, args.srdf, out, args.bodies_per_link, args.max_offset,
-            args.representation,
+            args.representation, args.package_dir or (),
         )  # fmt: skip
         scenario = parse_scenario(data, str(out), out.parent, check=True)
     except (MbmError, ScenarioError) as err:
@@ -155,6 +155,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--index", type=positive_int, help="with --archive: the problem, 1 to 100")
     q.add_argument("--urdf", required=True, metavar="ROBOT.urdf")
     q.add_argument("--srdf", metavar="ROBOT.srdf")
+    q.add_argument(
+        "--package-dir",
+        action="append",
+        metavar="DIR",
+        help="a folder holding the packages of the URDF's package:// mesh URIs (repeatable; "
+        "the URDF's folder, ROS_PACKAGE_PATH and example-robot-data's share folder are "
+        "searched too)",
+    )
     q.add_argument(
         "--representation",
         choices=REPRESENTATIONS,
