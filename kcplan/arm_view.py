@@ -29,10 +29,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
+
+from kcplan.arm.model import package_folders
 
 __all__ = [
     "LinkMesh",
@@ -193,6 +194,14 @@ def _primitive(shape):
     return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
 
 
+def _bvh_mesh(bvh) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Vertices (scaled) and triangles of the mesh Pinocchio read (a coal BVH model)."""
+    V = np.asarray(bvh.vertices(), dtype=float)
+    F = np.array([[t[0], t[1], t[2]] for t in map(bvh.tri_indices, range(bvh.num_tris))],
+                 dtype=np.int64).reshape(-1, 3)  # fmt: skip
+    return V, F
+
+
 def _geometry_meshes(
     objects, links, placements, joints, max_faces: int, own_colors: bool = True
 ) -> list[LinkMesh]:
@@ -200,12 +209,16 @@ def _geometry_meshes(
     placements; ``own_colors``: the meshes' materials, else the collision colour."""
     out = []
     for obj, link, placement, joint in zip(objects, links, placements, joints, strict=True):
-        primitive = None if obj.meshPath else _primitive(obj.geometry)
+        primitive = _primitive(obj.geometry)  # Pinocchio's meshPath is "BOX" etc. for these
         if primitive is not None:
             V, F = primitive
             C = np.tile(COLLISION_RGB, (len(F), 1))
         else:
-            V, F, C = _read_mesh(obj.meshPath, np.asarray(obj.meshScale, dtype=float))
+            try:
+                V, F, C = _read_mesh(obj.meshPath, np.asarray(obj.meshScale, dtype=float))
+            except (ImportError, ValueError, OSError):  # a format trimesh cannot read (a
+                V, F = _bvh_mesh(obj.geometry)  # .dae without pycollada): Pinocchio's copy
+                C = np.tile(COLLISION_RGB, (len(F), 1))
             if not own_colors:
                 C = np.tile(COLLISION_RGB, (len(F), 1))
         V, F = _merged(V, F)
@@ -222,9 +235,8 @@ def _visual_geometry(arm):
     urdf = arm.urdf
     full = pin.buildModelFromUrdf(urdf)
     try:
-        visual = pin.buildGeomFromUrdf(
-            full, urdf, pin.GeometryType.VISUAL, package_dirs=[str(Path(urdf).parent)]
-        )
+        folders = package_folders(urdf, arm.package_dirs)
+        visual = pin.buildGeomFromUrdf(full, urdf, pin.GeometryType.VISUAL, package_dirs=folders)
     except (RuntimeError, ValueError, OSError) as err:
         lines = str(err).strip().splitlines()
         return None, lines[0] if lines else type(err).__name__
@@ -291,19 +303,21 @@ def arm_meshes(arm, source: str = "auto", max_faces: int = 3000) -> tuple[list[L
 
 
 def cover_meshes(arm, subdivisions: int = 2) -> list[LinkMesh]:
-    """The covering ellipsoids of an arm as meshes: an icosphere scaled by each body's
-    semi-axes, placed at the body's frame."""
+    """The bodies of an arm as meshes, placed at the body's frame: a link's hull as its
+    triangles, an ellipsoid as an icosphere scaled by its semi-axes."""
     import trimesh
 
     sphere = trimesh.creation.icosphere(subdivisions)
     U, F = np.asarray(sphere.vertices, dtype=float), np.asarray(sphere.faces, dtype=np.int64)
     palette = np.array([[0.12, 0.47, 0.71], [1.0, 0.5, 0.05], [0.17, 0.63, 0.17],
                         [0.84, 0.15, 0.16], [0.58, 0.4, 0.74], [0.55, 0.34, 0.29]])  # fmt: skip
-    return [
-        LinkMesh(f"cover {k}", body.link, int(body.joint), np.asarray(body.placement),
-                 U * body.semi_axes, F, np.tile(palette[k % len(palette)], (len(F), 1)))
-        for k, body in enumerate(arm.bodies)
-    ]  # fmt: skip
+    out = []
+    for k, body in enumerate(arm.bodies):
+        hull = body.hull
+        V, T = (U * body.semi_axes, F) if hull is None else (hull.vertices, hull.triangles)
+        out.append(LinkMesh(f"cover {k}", body.link, int(body.joint), np.asarray(body.placement),
+                            V, T, np.tile(palette[k % len(palette)], (len(T), 1))))  # fmt: skip
+    return out
 
 
 def cylinder_mesh(ob, sections: int = 32) -> tuple[NDArray[np.float64], NDArray[np.int64]]:

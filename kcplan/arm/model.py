@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, mesh_hull
+from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, mesh_hull, points_hull
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
@@ -168,6 +168,8 @@ class ArmModel:
         geometries form a collision pair of :attr:`geometry`.
     urdf, srdf : str
         The files read (``srdf`` empty when none was given).
+    package_dirs : tuple of str
+        The folders of ``package://`` URIs given to :func:`load_arm`.
     """
 
     model: object
@@ -181,6 +183,7 @@ class ArmModel:
     self_pairs: NDArray[np.int64]
     urdf: str
     srdf: str = ""
+    package_dirs: tuple[str, ...] = ()
 
     @property
     def dof(self) -> int:
@@ -387,7 +390,13 @@ def load_arm(
             b = full_geometry.geometryObjects[pair.second].parentJoint
             if full.parents[a] == b or full.parents[b] == a:
                 full_geometry.removeCollisionPair(pair)
-    model, geometry = pin.buildReducedModel(full, full_geometry, locked, q_fixed)
+    try:
+        model, geometry = pin.buildReducedModel(full, full_geometry, locked, q_fixed)
+    except (RuntimeError, ValueError) as err:  # e.g. a link and a fixed joint of one name
+        raise ArmError(
+            f"{source}: joints: expected a group Pinocchio can reduce the URDF to (every "
+            f"other joint locked), got: {err}"
+        ) from None
     if len(geometry.geometryObjects) == 0:
         raise ArmError(f"{source}: collision: expected links with collision geometry, got none")
     ids = [model.getJointId(n) for n in group]
@@ -412,6 +421,7 @@ def load_arm(
     return ArmModel(
         model, geometry, tuple(group), q_index, np.array(lower), np.array(upper), kinds,
         tuple(bodies), self_pairs, source, "" if srdf is None else os.fspath(srdf),
+        tuple(os.fspath(d) for d in package_dirs or ()),
     )  # fmt: skip
 
 
@@ -472,17 +482,15 @@ def _hull(
     elif kind == "Cylinder":
         centre, hull = cylinder_hull(float(shape.radius), float(shape.halfLength))
     elif obj.meshPath:
-        scale = np.asarray(obj.meshScale, dtype=float)
-        if not np.allclose(scale, scale[0]):
-            raise ArmError(
-                f"{source}: collision: {obj.name}: expected a uniform mesh scale, "
-                f"got {scale.tolist()}"
-            )
         start = time.perf_counter()
-        try:
-            centre, hull = mesh_hull(obj.meshPath, float(scale[0]))
+        try:  # the vertices Pinocchio read (any format assimp reads, already scaled)
+            if hasattr(shape, "vertices"):
+                centre, hull = points_hull(np.asarray(shape.vertices(), dtype=float))
+            else:  # pragma: no cover - buildGeomFromUrdf makes every mesh a BVH model
+                scale = np.asarray(obj.meshScale, dtype=float)
+                centre, hull = mesh_hull(obj.meshPath, float(scale[0]))
         except ValueError as err:
-            raise ArmError(f"{source}: collision: {obj.name}: {err}") from None
+            raise ArmError(f"{source}: collision: {obj.name}: {obj.meshPath}: {err}") from None
         took = time.perf_counter() - start
         if progress is not None and took > 1.0:  # a large mesh: say where the time goes
             progress(f"{obj.name}: convex hull of {len(hull.vertices)} vertices in {took:.1f} s")

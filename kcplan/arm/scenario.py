@@ -3,7 +3,7 @@
 The format (``scenarios/README.md``)::
 
     name: box_1
-    robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,
+    robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,   # or example: NAME
             joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
             package_dirs: [DIR], representation: hulls, bodies_per_link: K,
             max_offset: E, inflation: 0.0}
@@ -14,9 +14,12 @@ The format (``scenarios/README.md``)::
                  {mesh: ...}]
     allowed: [[LINK, LINK], ...]      # link pairs allowed to touch (MoveIt's ACM)
 
-Paths are relative to the scenario file. ``package_dirs`` are folders that hold the
-packages of the URDF's ``package://PACKAGE/...`` mesh URIs, searched before the URDF's
-folder, ``ROS_PACKAGE_PATH`` and example-robot-data's share folder
+Paths are relative to the scenario file. ``example: NAME`` names an arm of
+example-robot-data (:data:`kcplan.arm.examples.EXAMPLE_ARMS`; its URDF, its SRDF where it
+has one, and its arm's joints unless ``joints`` is given) instead of ``urdf``.
+``package_dirs`` are folders that hold the packages of the URDF's
+``package://PACKAGE/...`` mesh URIs, searched before the URDF's folder,
+``ROS_PACKAGE_PATH`` and example-robot-data's share folder
 (:func:`kcplan.arm.model.package_folders`). ``joints`` is the planning group in state
 order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`).
 ``representation`` is ``hulls`` (each link its own convex hull, the default) or
@@ -42,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.examples import example_robot
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
 from kcplan.world.scenario import (
     MAX_OBSTACLES,
@@ -127,16 +131,30 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     if "dimension" in top and (isinstance(top["dimension"], bool) or top["dimension"] != 3):
         r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
     spec = r.mapping(
-        top["robot"], "robot", ("urdf", "joints"),
-        ("srdf", "fixed", "package_dirs", "representation", "bodies_per_link", "max_offset",
-         "inflation"),
+        top["robot"], "robot", (),
+        ("urdf", "example", "joints", "srdf", "fixed", "package_dirs", "representation",
+         "bodies_per_link", "max_offset", "inflation"),
     )  # fmt: skip
-    urdf = directory / r.text(spec["urdf"], "robot.urdf")
-    srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
+    if ("urdf" in spec) == ("example" in spec):
+        r.fail("robot", "a urdf (a file) or an example (a robot of example-robot-data)",
+               None, f"{'both' if 'urdf' in spec else 'neither'}")  # fmt: skip
+    if "example" in spec:
+        try:
+            urdf, srdf, default_joints = example_robot(r.text(spec["example"], "robot.example"))
+        except ArmError as err:
+            raise ScenarioError(f"{source}: {err}") from None
+        if "srdf" in spec:
+            srdf = directory / r.text(spec["srdf"], "robot.srdf")
+        spec.setdefault("joints", list(default_joints))
+    else:
+        urdf = directory / r.text(spec["urdf"], "robot.urdf")
+        srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
+        if "joints" not in spec:
+            r.fail("robot.joints", "the planning group: a list of joint names", None, "none")
     for key, path in (("urdf", urdf), ("srdf", srdf)):
         if path is not None and not path.is_file():
             r.fail(f"robot.{key}", f"an existing {key.upper()} file (relative to the scenario)",
-                   None, f"{spec[key]!r}, which does not exist at {path}")  # fmt: skip
+                   None, f"{spec.get(key)!r}, which does not exist at {path}")  # fmt: skip
     joints = spec["joints"]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         r.fail("robot.joints", "a list of joint names", joints)

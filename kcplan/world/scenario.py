@@ -461,7 +461,8 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
     """
     r = _Reader(source)
     directory = Path.cwd() if directory is None else directory
-    if isinstance(data, dict) and isinstance(data.get("robot"), dict) and "urdf" in data["robot"]:
+    robot = data.get("robot") if isinstance(data, dict) else None
+    if isinstance(robot, dict) and ("urdf" in robot or "example" in robot):
         from kcplan.arm.scenario import parse_arm_scenario  # an arm: its own format
 
         return parse_arm_scenario(data, source, directory)
