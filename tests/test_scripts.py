@@ -307,6 +307,15 @@ CASES.append(
 )
 
 CASES.append(
+    Case(  # needs example-robot-data (the dev extra has it)
+        "make_example_arm_scenarios.py",
+        ("--arms", "ur3", "-o", "{tmp}"),
+        (r"example_ur3\.yaml: reach 0\.7\d+ m, solved in ",),
+        ("example_ur3.yaml",),
+    )
+)
+
+CASES.append(
     Case(
         "pair_proofs.py",
         ("--robot", "panda", "--max-boxes", "400"),
