@@ -9,10 +9,13 @@ list of joints in state order; every other joint is locked at a fixed value
 group's joint vector (``nq`` = number of joints in the group).
 
 *Representations.* By default (``representation="hulls"``) every link is its own convex
-geometry (:mod:`kcplan.arm.hulls`): a mesh by its convex hull (exact for a convex mesh,
-the smallest convex body holding a non-convex one), a box exactly, a cylinder by a
-circumscribed prism, a sphere exactly (as an ellipsoid). Such a body keeps a bounding
-ball (``semi_axes`` all equal to its radius) for the speed bounds, and its hull for the
+geometry (:mod:`kcplan.arm.hulls`): a mesh by its convex hull (exact for a convex mesh),
+or where that hull exceeds a closed mesh by a mean gap of more than
+:data:`kcplan.arm.hulls.MAX_GAP` by the hulls of up to
+:data:`kcplan.arm.hulls.MAX_PIECES` pieces cut by planes
+(:func:`~kcplan.arm.hulls.hull_pieces`); a box exactly, a cylinder by a circumscribed
+prism, a sphere exactly (as an ellipsoid). Such a body keeps a bounding ball
+(``semi_axes`` all equal to its radius) for the speed bounds, and its hull for the
 collision queries. With ``representation="ellipsoids"`` every collision geometry is
 covered by ellipsoids (what the KC certificate needs): a mesh by :mod:`kcplan.cover` (its own
 triangles, a sound cover, cached per user; by default cut until it sticks out of the mesh
@@ -48,7 +51,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, mesh_hull, points_hull
+from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, hull_pieces, mesh_hull
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
@@ -410,10 +413,10 @@ def load_arm(
         placement = np.asarray(obj.placement.homogeneous, dtype=float)
         link = model.frames[obj.parentFrame].name
         if representation == "hulls":
-            frame, semi_axes, hull = _hull(obj, source, progress)
-            bodies.append(
-                ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes, hull)
-            )
+            for frame, semi_axes, hull in _hull(obj, source, progress):
+                bodies.append(
+                    ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes, hull)
+                )
             continue
         for frame, semi_axes in _cover(obj, bodies_per_link, max_offset, source, progress):
             bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
@@ -468,38 +471,51 @@ def _group(full, joints: Sequence[str], source: str) -> list[str]:
 
 def _hull(
     obj, source: str, progress: Callable[[str], None] | None = None
-) -> tuple[NDArray[np.float64], NDArray[np.float64], BodyHull | None]:
-    """``(frame, semi_axes, hull)`` of one geometry as its own convex body (module
-    docstring), the frame ``(4, 4)`` in the geometry's frame; a sphere is an ellipsoid
-    (``hull`` None)."""
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64], BodyHull | None]]:
+    """``(frame, semi_axes, hull)`` of each convex body of one geometry (module docstring:
+    its hull, or the hulls of its pieces where it is not convex), frames ``(4, 4)`` in
+    the geometry's frame; a sphere is an ellipsoid (``hull`` None)."""
     shape = obj.geometry
     kind = type(shape).__name__
-    frame = np.eye(4)
     if kind == "Sphere":
-        return frame, np.full(3, float(shape.radius)), None
+        return [(np.eye(4), np.full(3, float(shape.radius)), None)]
     if kind == "Box":
-        centre, hull = box_hull(np.asarray(shape.halfSide, dtype=float))
+        pieces = [box_hull(np.asarray(shape.halfSide, dtype=float))]
     elif kind == "Cylinder":
-        centre, hull = cylinder_hull(float(shape.radius), float(shape.halfLength))
+        pieces = [cylinder_hull(float(shape.radius), float(shape.halfLength))]
     elif obj.meshPath:
         start = time.perf_counter()
-        try:  # the vertices Pinocchio read (any format assimp reads, already scaled)
+        try:  # the mesh Pinocchio read (any format assimp reads, already scaled)
             if hasattr(shape, "vertices"):
-                centre, hull = points_hull(np.asarray(shape.vertices(), dtype=float))
+                triangles = np.array([[t[0], t[1], t[2]] for t in map(shape.tri_indices,
+                                      range(shape.num_tris))], dtype=np.int64)  # fmt: skip
+                vertices = np.asarray(shape.vertices(), dtype=float)
+                pieces = hull_pieces(vertices, triangles, slack=_single_precision(vertices))
             else:  # pragma: no cover - buildGeomFromUrdf makes every mesh a BVH model
                 scale = np.asarray(obj.meshScale, dtype=float)
-                centre, hull = mesh_hull(obj.meshPath, float(scale[0]))
+                pieces = [mesh_hull(obj.meshPath, float(scale[0]))]
         except ValueError as err:
             raise ArmError(f"{source}: collision: {obj.name}: {obj.meshPath}: {err}") from None
         took = time.perf_counter() - start
         if progress is not None and took > 1.0:  # a large mesh: say where the time goes
-            progress(f"{obj.name}: convex hull of {len(hull.vertices)} vertices in {took:.1f} s")
+            count = sum(len(h.vertices) for _, h in pieces)
+            progress(f"{obj.name}: {len(pieces)} hull(s) of {count} vertices in {took:.1f} s")
     else:
         raise ArmError(
             f"{source}: collision: {obj.name}: expected a mesh, box, cylinder or sphere, got {kind}"
         )
-    frame[:3, 3] = centre
-    return frame, np.full(3, hull.radius), hull
+    out = []
+    for centre, hull in pieces:
+        frame = np.eye(4)
+        frame[:3, 3] = centre
+        out.append((frame, np.full(3, hull.radius), hull))
+    return out
+
+
+def _single_precision(vertices: NDArray[np.float64]) -> float:
+    """How far a vertex Pinocchio read may lie from the file's (metres): assimp keeps
+    single precision, a relative 2^-24 of each coordinate, so 2^-23 of the largest."""
+    return 2.0**-23 * float(np.abs(vertices).max(initial=0.0))
 
 
 def _cover(
