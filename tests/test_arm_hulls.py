@@ -365,3 +365,20 @@ def test_a_non_convex_link_becomes_hull_pieces_that_hold_it():
     assert inside.all()
     box = trimesh.creation.box()
     assert len(hull_pieces(box.vertices, box.faces)) == 1
+
+
+def test_hull_pieces_are_cached_per_mesh(tmp_path, monkeypatch):
+    """A mesh's hulls are proved once per machine: the second call reads the same pieces
+    from the cache (KCPLAN_CACHE_DIR/hulls), and other numbers miss it."""
+    from kcplan.arm.hulls import cached_hull_pieces
+
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
+    mesh = trimesh.load(PANDA / "meshes" / "collision" / "link3.obj", force="mesh")
+    first, cached = cached_hull_pieces(mesh.vertices, mesh.faces, 1e-9)
+    assert not cached and len(list((tmp_path / "hulls").iterdir())) == 1
+    again, cached = cached_hull_pieces(mesh.vertices, mesh.faces, 1e-9)
+    assert cached and len(again) == len(first) == 1
+    np.testing.assert_array_equal(again[0][1].vertices, first[0][1].vertices)
+    assert again[0][1].radius == first[0][1].radius
+    _, cached = cached_hull_pieces(mesh.vertices, mesh.faces, 2e-9)
+    assert not cached

@@ -41,11 +41,15 @@ __all__ = [
     "MAX_PIECES",
     "BodyHull",
     "box_hull",
+    "cached_hull_pieces",
     "cylinder_hull",
     "hull_pieces",
     "mesh_hull",
     "points_hull",
 ]
+
+HULL_VERSION = 1
+"""Bumped whenever :func:`hull_pieces` would compute other hulls: the cache's key has it."""
 
 MAX_PIECES = 4
 """Hull pieces a non-convex link is cut into at most (:func:`hull_pieces`)."""
@@ -302,3 +306,47 @@ def _check_cover(points: NDArray[np.float64], pieces: list) -> None:
         inside |= ((points - centre) @ n.T - h <= 0.0).all(axis=1)
     if not inside.all():
         raise ValueError(f"{int((~inside).sum())} vertices outside every hull piece")
+
+
+def cached_hull_pieces(
+    vertices: NDArray[np.float64], triangles: NDArray[np.int64], slack: float = 0.0
+) -> tuple[list[tuple[NDArray[np.float64], BodyHull]], bool]:
+    """:func:`hull_pieces` of a mesh, kept in the per-user cache of covers
+    (:func:`kcplan.cover.cache.cache_folder`, subfolder ``hulls``), keyed by the mesh's
+    exact numbers, ``slack``, :data:`MAX_PIECES`, :data:`MAX_GAP` and
+    :data:`HULL_VERSION`: a large mesh's hull (the UR5's force sensor, 21,758 vertices:
+    about 2 s) is proved once per machine. Also returns whether it came from the cache. A
+    cache that cannot be read or written is skipped."""
+    import hashlib
+
+    from kcplan.cover.cache import cache_folder
+    from kcplan.files import atomic_output
+
+    vertices = np.ascontiguousarray(vertices, dtype=float)
+    triangles = np.ascontiguousarray(triangles, dtype=np.int64)
+    digest = hashlib.sha256(vertices.tobytes() + triangles.tobytes())
+    digest.update(repr((float(slack), MAX_PIECES, MAX_GAP, HULL_VERSION)).encode())
+    path = cache_folder() / "hulls" / f"{digest.hexdigest()}.npz"
+    try:
+        with np.load(path) as data:
+            count = int(data["count"])
+            return [
+                (data[f"centre{k}"], BodyHull(data[f"vertices{k}"], data[f"triangles{k}"],
+                                              float(data[f"radius{k}"]), float(data[f"offset{k}"])))
+                for k in range(count)
+            ], True  # fmt: skip
+    except (OSError, KeyError, ValueError):
+        pass
+    pieces = hull_pieces(vertices, triangles, slack=slack)
+    arrays: dict = {"count": len(pieces)}
+    for k, (centre, hull) in enumerate(pieces):
+        arrays |= {f"centre{k}": centre, f"vertices{k}": hull.vertices,
+                   f"triangles{k}": hull.triangles, f"radius{k}": hull.radius,
+                   f"offset{k}": hull.offset}  # fmt: skip
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_output(path) as tmp, open(tmp, "wb") as f:
+            np.savez(f, **arrays)
+    except OSError:
+        pass
+    return pieces, False

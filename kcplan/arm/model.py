@@ -51,7 +51,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.hulls import BodyHull, box_hull, cylinder_hull, hull_pieces, mesh_hull
+from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull, mesh_hull
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
@@ -490,7 +490,7 @@ def _hull(
                 triangles = np.array([[t[0], t[1], t[2]] for t in map(shape.tri_indices,
                                       range(shape.num_tris))], dtype=np.int64)  # fmt: skip
                 vertices = np.asarray(shape.vertices(), dtype=float)
-                pieces = hull_pieces(vertices, triangles, slack=_single_precision(vertices))
+                pieces, _ = cached_hull_pieces(vertices, triangles, _single_precision(vertices))
             else:  # pragma: no cover - buildGeomFromUrdf makes every mesh a BVH model
                 scale = np.asarray(obj.meshScale, dtype=float)
                 pieces = [mesh_hull(obj.meshPath, float(scale[0]))]
