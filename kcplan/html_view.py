@@ -252,7 +252,7 @@ _ARM_CONTROLS = """<div id="kcplan-controls" style="font:13px sans-serif;padding
 <span id="kc-label"></span>
 <label style="margin-left:1em"><input id="kc-arm" type="checkbox" checked> arm</label>
 <label style="margin-left:1em"><input id="kc-cover" type="checkbox"{cover}>
- covering ellipsoids</label>
+ bodies (hulls or ellipsoids)</label>
 </div>
 """
 
@@ -263,7 +263,8 @@ _ARM_SCRIPT = """
 (function () {
   var gd = document.getElementById('{plot_id}');
   var D = JSON.parse(document.getElementById('@DATA_ID@').textContent);
-  D.cover.forEach(function (c) {  // each body: the unit sphere scaled by its semi-axes
+  D.cover.forEach(function (c) {  // an ellipsoid: the unit sphere scaled by its semi-axes
+    if (c.vertices) return;  // a link's hull: its own vertices and faces
     c.vertices = D.sphere.vertices.map(function (v, i) { return v * c.semi_axes[i % 3]; });
     c.faces = D.sphere.faces;
   });
@@ -432,6 +433,8 @@ def arm_view_data(
         {"name": f"cover {k}", "link": b.link, "joint": int(b.joint),
          "placement": np.asarray(b.placement)[:3].ravel().tolist(),
          "semi_axes": np.asarray(b.semi_axes).tolist(), "palette": palette[k]}
+        | ({} if b.hull is None else {"vertices": np.round(b.hull.vertices, 6).ravel().tolist(),
+                                      "faces": b.hull.triangles.ravel().tolist()})
         for k, b in enumerate(arm.bodies)
     ]  # fmt: skip
 
