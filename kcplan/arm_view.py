@@ -291,7 +291,8 @@ def arm_meshes(arm, source: str = "auto", max_faces: int = 3000) -> tuple[list[L
     if source != "collision":
         found, reason = _visual_geometry(arm)
         if found is not None:
-            return _geometry_meshes(*found, max_faces), "visual meshes"
+            held = _attached_meshes(arm, max_faces)  # not in the URDF's visual geometry
+            return _geometry_meshes(*found, max_faces) + held, "visual meshes"
         if source == "visual":
             raise ValueError(f"{arm.urdf}: visual: {reason}")
     objects = list(arm.geometry.geometryObjects)
@@ -300,6 +301,15 @@ def arm_meshes(arm, source: str = "auto", max_faces: int = 3000) -> tuple[list[L
     links = [arm.model.frames[o.parentFrame].name for o in objects]
     what = "collision meshes" + (f" (no visual meshes: {reason})" if reason else "")
     return _geometry_meshes(objects, links, placements, joints, max_faces, False), what
+
+
+def _attached_meshes(arm, max_faces: int) -> list[LinkMesh]:
+    """The objects the arm holds (:mod:`kcplan.arm.attach`), from its collision geometry."""
+    names = {obj.name for obj in arm.attached}
+    objects = [o for o in arm.geometry.geometryObjects if o.name in names]
+    placements = [np.asarray(o.placement.homogeneous, dtype=float) for o in objects]
+    return _geometry_meshes(objects, [o.name for o in objects], placements,
+                            [int(o.parentJoint) for o in objects], max_faces, False)  # fmt: skip
 
 
 def cover_meshes(arm, subdivisions: int = 2) -> list[LinkMesh]:

@@ -66,9 +66,11 @@ __all__ = [
     "ArmBody",
     "ArmError",
     "ArmModel",
+    "hull_bodies",
     "load_arm",
     "mesh_cover",
     "package_folders",
+    "self_pairs_of",
 ]
 
 DEFAULT_MAX_OFFSET = 0.01
@@ -173,6 +175,11 @@ class ArmModel:
         The files read (``srdf`` empty when none was given).
     package_dirs : tuple of str
         The folders of ``package://`` URIs given to :func:`load_arm`.
+    attached : tuple of kcplan.arm.attach.Attached
+        The objects the arm holds (:func:`kcplan.arm.attach.attach`), each one more
+        collision object of :attr:`geometry` and bodies named after it.
+    base_geometry : pinocchio.GeometryModel or None
+        :attr:`geometry` without the attached objects (None when none is attached).
     """
 
     model: object
@@ -187,6 +194,8 @@ class ArmModel:
     urdf: str
     srdf: str = ""
     package_dirs: tuple[str, ...] = ()
+    attached: tuple = ()
+    base_geometry: object = None
 
     @property
     def dof(self) -> int:
@@ -413,14 +422,14 @@ def load_arm(
         placement = np.asarray(obj.placement.homogeneous, dtype=float)
         link = model.frames[obj.parentFrame].name
         if representation == "hulls":
-            for frame, semi_axes, hull in _hull(obj, source, progress):
+            for frame, semi_axes, hull in hull_bodies(obj, source, progress):
                 bodies.append(
                     ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes, hull)
                 )
             continue
         for frame, semi_axes in _cover(obj, bodies_per_link, max_offset, source, progress):
             bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
-    self_pairs = _self_pairs(geometry, bodies)
+    self_pairs = self_pairs_of(geometry, bodies)
     return ArmModel(
         model, geometry, tuple(group), q_index, np.array(lower), np.array(upper), kinds,
         tuple(bodies), self_pairs, source, "" if srdf is None else os.fspath(srdf),
@@ -469,7 +478,7 @@ def _group(full, joints: Sequence[str], source: str) -> list[str]:
     return group
 
 
-def _hull(
+def hull_bodies(
     obj, source: str, progress: Callable[[str], None] | None = None
 ) -> list[tuple[NDArray[np.float64], NDArray[np.float64], BodyHull | None]]:
     """``(frame, semi_axes, hull)`` of each convex body of one geometry (module docstring:
@@ -596,7 +605,7 @@ def mesh_cover(
         return cover, f"{origin} (its convex hull: the mesh is not closed)"
 
 
-def _self_pairs(geometry, bodies: list[ArmBody]) -> NDArray[np.int64]:
+def self_pairs_of(geometry, bodies: Sequence[ArmBody]) -> NDArray[np.int64]:
     """Body pairs whose geometries form a collision pair of ``geometry``."""
     by_geometry: dict[int, list[int]] = {}
     for k, body in enumerate(bodies):

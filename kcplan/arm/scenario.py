@@ -13,6 +13,8 @@ The format (``scenarios/README.md``)::
                  radius, height}}, {sphere: ...}, {ellipsoid: ...}, {convex: ...},
                  {mesh: ...}]
     allowed: [[LINK, LINK], ...]      # link pairs allowed to touch (MoveIt's ACM)
+    attached: [{link: panda_hand, name: part, box: {center, size, quaternion},
+                touch: [panda_leftfinger, panda_rightfinger]}]   # held, in the link's frame
 
 Paths are relative to the scenario file. ``example: NAME`` names an arm of
 example-robot-data (:data:`kcplan.arm.examples.EXAMPLE_ARMS`; its URDF, its SRDF where it
@@ -45,6 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.attach import Attached, attach
 from kcplan.arm.examples import example_robot
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
 from kcplan.world.scenario import (
@@ -122,7 +125,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     r = _Reader(source)
     top = r.mapping(
         data, "top level", ("name", "robot", "start", "goal"),
-        ("dimension", "description", "obstacles", "allowed"),
+        ("dimension", "description", "obstacles", "allowed", "attached"),
     )  # fmt: skip
     name = r.text(top["name"], "name")
     description = top.get("description", "")
@@ -194,6 +197,12 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         )  # fmt: skip
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None
+    held = _attached(r, top.get("attached") or [], directory)
+    if held:
+        try:
+            arm = attach(arm, held)
+        except ArmError as err:
+            raise ScenarioError(f"{source}: {err}") from None
     start, goal = (_joints(r, top[key], key, arm) for key in ("start", "goal"))
     items = top.get("obstacles") or []
     if not isinstance(items, list):
@@ -211,6 +220,32 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
         description, source, directory,
     )  # fmt: skip
+
+
+def _attached(r: _Reader, value: Any, directory: Path) -> list[Attached]:
+    """The objects the arm holds: ``[{link, name, box|cylinder|sphere|mesh: {...}, touch}]``,
+    each shape's fields those of an obstacle, in the link's frame."""
+    if not isinstance(value, list):
+        r.fail("attached", "a list of objects held by links", value)
+    out = []
+    for i, item in enumerate(value):
+        where = f"attached[{i}]"
+        shapes = ("box", "cylinder", "sphere", "mesh")
+        spec = r.mapping(item, where, ("link",), ("name", "touch", *shapes))
+        kinds = [k for k in shapes if k in spec]
+        if len(kinds) != 1:
+            r.fail(where, f"one shape of {', '.join(shapes)}", None, ", ".join(kinds) or "none")
+        kind = kinds[0]
+        if kind == "cylinder":
+            shape = _cylinder(r, spec[kind], i)
+        else:
+            shape = _obstacle(r, {kind: spec[kind]}, i, 3, directory)
+        touch = spec.get("touch", [])
+        if not isinstance(touch, list) or not all(map(_is_text, touch)):
+            r.fail(f"{where}.touch", "a list of link names", touch)
+        name = r.text(spec.get("name", f"attached{i}"), f"{where}.name")
+        out.append(Attached(name, r.text(spec["link"], f"{where}.link"), shape, tuple(touch)))
+    return out
 
 
 def _allowed(r: _Reader, value: Any) -> frozenset:
@@ -248,4 +283,10 @@ def arm_scenario_to_dict(scenario: ArmScenario) -> dict:
     out["obstacles"] = [{o.kind: o.spec} for o in scenario.obstacles]
     if scenario.allowed:
         out["allowed"] = sorted(sorted(pair) for pair in scenario.allowed)
+    if scenario.arm.attached:
+        out["attached"] = [
+            {"link": a.link, "name": a.name, a.shape.kind: a.shape.spec}
+            | ({"touch": list(a.touch)} if a.touch else {})
+            for a in scenario.arm.attached
+        ]
     return out

@@ -102,7 +102,22 @@ def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
     if kind == "Cylinder":
         r, c = float(shape.radius), float(shape.halfLength)
         return fcl.Cylinder(r, 2 * c), math.hypot(r, c)
+    if not obj.meshPath:  # a mesh given by its triangles (an attached object's)
+        return _bvh(shape)
     return _mesh(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
+
+
+def _bvh(shape) -> tuple[fcl.BVHModel, float]:
+    """A coal BVH model's triangles as an FCL BVH model, and its farthest vertex's
+    distance from its origin."""
+    V = np.asarray(shape.vertices(), dtype=float)
+    F = np.array([[t[0], t[1], t[2]] for t in map(shape.tri_indices, range(shape.num_tris))],
+                 dtype=np.int32).reshape(-1, 3)  # fmt: skip
+    model = fcl.BVHModel()
+    model.beginModel(len(V), len(F))
+    model.addSubModel(V, F)
+    model.endModel()
+    return model, float(np.linalg.norm(V, axis=1).max())
 
 
 class ArmMeshChecker:
