@@ -51,6 +51,9 @@ class ArmPathCheck:
         Smallest link distance seen (to an obstacle or another link), metres.
     where : tuple
         ``(segment, s)`` of the first contact, or ``()``.
+    what : str
+        What touches there: ``LINK and an obstacle`` or ``LINK and LINK`` (a held
+        object counts as a link, by its name), or ``""``.
     queries : int
         Distance queries made (a link against the scene, or two links).
     """
@@ -59,6 +62,7 @@ class ArmPathCheck:
     min_clearance: float
     where: tuple = ()
     queries: int = 0
+    what: str = ""
 
 
 @functools.lru_cache(maxsize=256)
@@ -160,14 +164,17 @@ class ArmMeshChecker:
             self._links.append(fcl.CollisionObject(shape, fcl.Transform()))
             hull = (
                 _hull(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
-                if (isinstance(shape, fcl.BVHModel))
+                if isinstance(shape, fcl.BVHModel) and obj.meshPath
                 else None
             )
             self._hulls.append(None if hull is None else fcl.CollisionObject(hull, fcl.Transform()))
             # the geometry's points lie within its placement's length plus its own reach
             reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)
             joints.append(int(obj.parentJoint))
-        link = [arm.model.frames[obj.parentFrame].name for obj in geometry.geometryObjects]
+        held = {obj.name for obj in arm.attached}  # a held object goes by its own name
+        link = [obj.name if obj.name in held else arm.model.frames[obj.parentFrame].name
+                for obj in geometry.geometryObjects]  # fmt: skip
+        self._names = link
         self._pairs = np.array(
             [
                 (p.first, p.second)
@@ -225,6 +232,14 @@ class ArmMeshChecker:
                 return near
         return _distance(self._links[a], self._links[b])
 
+    def _what(self, item: int) -> str:
+        """The names of item ``item``'s two sides (:attr:`ArmPathCheck.what`)."""
+        links = len(self._links)
+        if item < links:
+            return f"{self._names[item]} and an obstacle"
+        a, b = self._pairs[item - links]
+        return f"{self._names[a]} and {self._names[b]}"
+
     def _scene_distance(self, obj: fcl.CollisionObject) -> float:
         result = fcl.DistanceData()
         self._manager.distance(obj, result, fcl.defaultDistanceCallback)
@@ -251,7 +266,8 @@ class ArmMeshChecker:
                     queries += 1
                     lowest = min(lowest, d)
                     if d <= self.tolerance:
-                        return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries)
+                        return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries,
+                                            self._what(int(item)))  # fmt: skip
                     # free on [s, s + d / v): this item's next sample is there
                     v = speeds[item]
                     step = d / v if v > 0 else math.inf

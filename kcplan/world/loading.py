@@ -31,10 +31,11 @@ def check_start_goal(scenario: Scenario) -> None:
         for key, q in (("start", scenario.start), ("goal", scenario.goal)):
             if not arm_world.in_collision(q):
                 continue
-            if verify_arm_path(arm, obstacles, [q, q], allowed=scenario.allowed).collides:
+            meshes = verify_arm_path(arm, obstacles, [q, q], allowed=scenario.allowed)
+            if meshes.collides:
                 raise ScenarioError(
                     f"{scenario.source}: {key}: the arm's links touch an obstacle or each "
-                    "other (on their own collision meshes too)"
+                    f"other (on their own collision meshes too): {meshes.what}"
                 )
             hulls = any(b.hull is not None for b in arm.bodies)
             hint = (
