@@ -267,8 +267,11 @@ def test_the_chain_bounds_a_prismatic_joint(tmp_path):
         "<origin xyz='0 0.2 0'/><axis xyz='0 0 1'/>"
         "<limit lower='-2' upper='2' effort='1' velocity='1'/></joint></robot>"
     )
-    arm = load_arm(urdf, ["slide", "elbow"])
+    srdf = tmp_path / "slide.srdf"  # disables nothing: the joined links' pair is checked
+    srdf.write_text("<robot name='s'></robot>")
+    arm = load_arm(urdf, ["slide", "elbow"], srdf=srdf)
     assert arm.kinds == ("prismatic", "revolute") and len(arm.self_pairs) == 1
+    assert len(load_arm(urdf, ["slide", "elbow"]).self_pairs) == 0  # no SRDF: joined, allowed
     rng = np.random.default_rng(5)
     for _ in range(10):
         _check_speeds(arm, rng.uniform(arm.lower, arm.upper), rng.uniform(arm.lower, arm.upper))
