@@ -21,27 +21,30 @@ import time
 from pathlib import Path
 
 from kcplan.arm import load_arm
-from kcplan.arm.mbm import load_mbm_archive
 from kcplan.arm.pairs import MAX_BOXES, prove_pairs
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"
 
 
+GROUPS = {  # the planning groups of MBM's problems
+    "panda": tuple(f"panda_joint{i}" for i in range(1, 8)),
+    "ur5": ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+            "wrist_2_joint", "wrist_3_joint"),
+}  # fmt: skip
+
+
 def robot_files(name: str) -> tuple[Path, Path, tuple[str, ...]]:
     """URDF, SRDF and planning group of one MBM robot."""
-    folder = MBM / name
-    urdf = folder / f"{name}.urdf"
+    urdf = MBM / name / f"{name}.urdf"
     if name == "panda":  # the bundled copy: the same URDF, its meshes beside it
         urdf = ROOT / "scenarios" / "arm" / "panda" / "panda.urdf"
-    srdf = urdf.with_suffix(".srdf")
-    problems = load_mbm_archive(folder / "problems.tar.bz2")
-    return urdf, srdf, next(iter(problems.values())).joints
+    return urdf, urdf.with_suffix(".srdf"), GROUPS[name]
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--robot", default="panda,ur5", help="MBM robots, comma-separated")
+    parser.add_argument("--robot", default="panda,ur5", help="MBM robots: panda, ur5")
     parser.add_argument("--max-boxes", type=int, default=MAX_BOXES)
     args = parser.parse_args(argv)
     print("| robot | links | pairs (no SRDF) | proven apart | touch | unknown | SRDF checks "
