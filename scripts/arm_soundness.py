@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from kcplan.arm import ArmWorld, load_arm
+from kcplan.arm.attach import Attached, attach
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
 from kcplan.arm.verify import ArmMeshChecker
 from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
@@ -101,6 +102,8 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
                    fixed=_known(folder / f"{args.robot}.urdf", fixed),
                    bodies_per_link=args.bodies, max_offset=args.max_offset,
                    representation=args.representation)  # fmt: skip
+    if args.attach:
+        arm = attach(arm, [held_part(args.robot, args.attach)])
     print(f"{len(chosen)} problems, {arm.describe()}, {len(arm.self_pairs)} self pairs, "
           f"ready in {time.perf_counter() - t0:.1f} s", file=out, flush=True)  # fmt: skip
     c = {"edges": 0, "accepted": 0, "violations": 0, "verified": 0, "twin": 0,
@@ -183,6 +186,44 @@ def _known(urdf: Path, fixed: dict) -> dict:
     return {k: v for k, v in fixed.items() if model.existJointName(k)}
 
 
+PARTS = {  # a part held between the fingers, in the hand's frame (the gripper's axis z)
+    "box": {"center": [0.0, 0.0, 0.12], "size": [0.04, 0.04, 0.16],
+            "quaternion": [0.0, 0.0, 0.38268343, 0.92387953]},
+    "cylinder": {"center": [0.0, 0.0, 0.12], "radius": 0.03, "height": 0.15},
+    "mesh": {"file": "meshes/collision/finger.obj", "scale": 2.0,
+             "position": [0.0, 0.0, 0.1]},
+}  # fmt: skip
+HANDS = {  # the link that holds it and the links that may touch it
+    "panda": ("panda_hand", ("panda_leftfinger", "panda_rightfinger")),
+    "ur5": ("robotiq_85_base_link", tuple(f"robotiq_85_{side}_{part}_link"
+                                          for side in ("left", "right")
+                                          for part in ("knuckle", "finger", "inner_knuckle",
+                                                       "finger_tip"))),
+}  # fmt: skip
+
+
+def held_part(robot: str, shape: str) -> Attached:
+    """The part of ``--attach``: :data:`PARTS` held by the robot's hand (:data:`HANDS`); a
+    mesh part is the bundled Panda's finger, twice its size."""
+    from kcplan.world import parse_scenario
+
+    data = {"name": "part", "dimension": 3,
+            "bounds": {"low": [-1.0, -1.0, -1.0], "high": [1.0, 1.0, 1.0]},
+            "robot": {"semi_axes": [0.1, 0.1, 0.1]},
+            "start": {"position": [0.0, 0.0, 0.0]}, "goal": {"position": [0.0, 0.0, 0.0]},
+            "obstacles": [{shape: PARTS[shape]}]}  # fmt: skip
+    if shape == "cylinder":  # the arm scenario's kind: read there
+        from kcplan.arm.scenario import _cylinder
+        from kcplan.world.scenario import _Reader
+
+        part = _cylinder(_Reader("part"), PARTS[shape], 0)
+    else:
+        folder = ROOT / "scenarios" / "arm" / "panda"
+        part = parse_scenario(data, "part", folder, check=False).obstacles[0]
+    link, touch = HANDS[robot]
+    return Attached("part", link, part, touch)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", choices=("panda", "ur5"), default="panda")
@@ -200,6 +241,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--representation", choices=("hulls", "ellipsoids"), default=None,
                         help="the links' bodies (default: ellipsoids; hulls: kcplan's "
                         "default, each link its own convex hull)")  # fmt: skip
+    parser.add_argument("--attach", choices=sorted(PARTS), default=None,
+                        help="the arm holds a part of this shape between its fingers "
+                        "(hulls only): every check includes it")  # fmt: skip
     parser.add_argument("--twin", type=int, default=0, help="edges also decided in Python")
     parser.add_argument("--free-check", type=float, default=0.05,
                         help="fraction of rejected edges verified on the meshes")  # fmt: skip

@@ -149,6 +149,11 @@ CASES = [
             rf"mesh verification {NUMBER} ms per edge",
         ),
     ),
+    Case(  # on hulls, holding a part between the fingers
+        "arm_soundness.py",
+        ("--edges", "8", "--per-class", "1", "--representation", "hulls", "--attach", "cylinder"),
+        (r"^\| panda \| kernel \| 8 \| \d+ \| 0 \| ", r"arm of 7 joints, 12 bodies"),
+    ),
     Case(
         "edge_outcomes.py",
         (CORRIDOR, "kc-rrtconnect", "1,2", "--probes", "1", "--time", "5"),

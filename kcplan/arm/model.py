@@ -492,7 +492,7 @@ def hull_bodies(
         pieces = [box_hull(np.asarray(shape.halfSide, dtype=float))]
     elif kind == "Cylinder":
         pieces = [cylinder_hull(float(shape.radius), float(shape.halfLength))]
-    elif obj.meshPath:
+    elif obj.meshPath or hasattr(shape, "vertices"):  # a file, or triangles (a held mesh)
         start = time.perf_counter()
         try:  # the mesh Pinocchio read (any format assimp reads, already scaled)
             if hasattr(shape, "vertices"):
