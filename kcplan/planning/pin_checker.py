@@ -2,9 +2,9 @@
 
 The checker of the ``rrtconnect-pin`` planner (:data:`kcplan.planning.problem.PLANNERS`):
 stock OMPL RRT-Connect at OMPL's default resolution whose ``isValid`` is this Python
-function. It holds the *same* ellipsoid cover as :class:`kcplan.arm.world.ArmWorld` (the
-bodies of :attr:`kcplan.arm.ArmModel.bodies`), as coal ``Ellipsoid`` shapes in a
-``pinocchio.GeometryModel``, each attached to the joint that carries its link at the
+function. It holds the *same* bodies as :class:`kcplan.arm.world.ArmWorld` (those of
+:attr:`kcplan.arm.ArmModel.bodies`: links' hulls as coal ``Convex`` shapes, ellipsoids as
+``Ellipsoid`` shapes) in a ``pinocchio.GeometryModel``, each attached to the joint that carries its link at the
 body's placement in that joint's frame; the scene's obstacles are geometry objects of
 that model too, fixed to the universe (joint 0) at their pose. The collision pairs are
 the checked self pairs (:attr:`ArmWorld.self_pairs`: the SRDF's disabled pairs and the
@@ -14,12 +14,8 @@ valid when it lies inside the joint limits and
 contact after ``pinocchio.forwardKinematics`` and ``pinocchio.updateGeometryPlacements``
 placed the bodies.
 
-Obstacles become the same solids as in :func:`kcplan.world.collision.fcl_obstacle_parts`:
-a box is a coal ``Box`` at its pose (python-fcl's world builds a rotated box as the convex
-hull of its corners: the same solid), a sphere a ``Sphere``, a cylinder a ``Cylinder``
-(axis along its local z), an ellipsoid an ``Ellipsoid``, a convex obstacle the coal
-``Convex`` hull of its vertices, a mesh a ``BVHModelOBBRSS`` of its triangles (a surface,
-as python-fcl's ``BVHModel``). ``tests/test_arm_peers.py`` compares the verdicts with
+Obstacles become the same solids as in :func:`kcplan.world.collision.fcl_obstacle_parts`
+(:func:`kcplan.arm.shapes.coal_obstacle`). ``tests/test_arm_peers.py`` compares the verdicts with
 :meth:`ArmWorld.in_collision` on random Panda states.
 
 This is discrete state checking, not certification: OMPL's motion validator samples the
@@ -38,7 +34,7 @@ from kcplan.arm.shapes import coal_obstacle
 from kcplan.arm.world import checked_pairs
 from kcplan.world.scenario import Obstacle
 
-__all__ = ["PinChecker", "coal_obstacle"]
+__all__ = ["PinChecker"]
 
 
 class PinChecker:
