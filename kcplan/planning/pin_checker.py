@@ -5,8 +5,8 @@ stock OMPL RRT-Connect at OMPL's default resolution whose ``isValid`` is this Py
 function. It holds the *same* bodies as :class:`kcplan.arm.world.ArmWorld` (those of
 :attr:`kcplan.arm.ArmModel.bodies`: links' hulls as coal ``Convex`` shapes, ellipsoids as
 ``Ellipsoid`` shapes) in a ``pinocchio.GeometryModel``, each attached to the joint that
-carries its link at the body's placement in that joint's frame; the scene's obstacles are geometry objects of
-that model too, fixed to the universe (joint 0) at their pose. The collision pairs are
+carries its link at the body's placement in that joint's frame; the scene's obstacles
+are geometry objects of that model too, fixed to the universe (joint 0) at their pose. The collision pairs are
 the checked self pairs (:attr:`ArmWorld.self_pairs`: the SRDF's disabled pairs and the
 scene's allowed collision matrix removed) and every body with every obstacle. A state is
 valid when it lies inside the joint limits and
