@@ -6,10 +6,10 @@ function. It holds the *same* bodies as :class:`kcplan.arm.world.ArmWorld` (thos
 :attr:`kcplan.arm.ArmModel.bodies`: links' hulls as coal ``Convex`` shapes, ellipsoids as
 ``Ellipsoid`` shapes) in a ``pinocchio.GeometryModel``, each attached to the joint that
 carries its link at the body's placement in that joint's frame; the scene's obstacles
-are geometry objects of that model too, fixed to the universe (joint 0) at their pose. The collision pairs are
-the checked self pairs (:attr:`ArmWorld.self_pairs`: the SRDF's disabled pairs and the
-scene's allowed collision matrix removed) and every body with every obstacle. A state is
-valid when it lies inside the joint limits and
+are geometry objects of that model too, fixed to the universe (joint 0) at their pose.
+The collision pairs are the checked self pairs (:attr:`ArmWorld.self_pairs`: the SRDF's
+disabled pairs and the scene's allowed collision matrix removed) and every body with
+every obstacle. A state is valid when it lies inside the joint limits and
 ``pinocchio.computeCollisions(geometry_model, geometry_data, True)`` finds no pair in
 contact after ``pinocchio.forwardKinematics`` and ``pinocchio.updateGeometryPlacements``
 placed the bodies.
