@@ -79,7 +79,7 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
       for (const coal::Vec3s& v : *body.hull->shape()->points) {
         double inside = 0.0;  // |diag(a)^-1 v|^2: at most 1 inside the ellipsoid
         for (int i = 0; i < 3; ++i) inside += (v[i] / body.semi_axes[i]) * (v[i] / body.semi_axes[i]);
-        if (!(inside <= 1.0 + 1e-9))
+        if (!(inside <= 1.0))  // strictly: every speed bound is the ellipsoid's
           throw std::invalid_argument("chain: a body's hull must lie inside its semi-axes' ellipsoid");
       }
     }
