@@ -12,7 +12,9 @@ represented by its own hull (:func:`hull_pieces`).
 
 The hull is computed by qhull (through trimesh) and then *proved* to hold every vertex of
 the mesh: ``delta``, the largest amount by which a mesh vertex lies outside a hull face
-(rounding in qhull, ~1e-16 m), is measured, and where it is positive the hull is grown
+(rounding in qhull, ~1e-16 m), is measured, plus a ``slack`` for points known only to
+within it (Pinocchio reads meshes in single precision), and where that is positive the
+hull is grown
 about the mean ``c`` of its vertices (strictly inside it) by ``1 + 2 delta / rho``
 (``rho`` the smallest distance from ``c`` to a face plane): each face plane ``n . x <= h``
 then moves outward by ``2 delta (h - n . c) / rho >= 2 delta``, so no vertex is outside
@@ -37,6 +39,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "CYLINDER_SIDES",
+    "HULL_VERSION",
     "MAX_GAP",
     "MAX_PIECES",
     "BodyHull",
