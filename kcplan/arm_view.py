@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.arm.model import package_folders
+from kcplan.arm.shapes import bvh_mesh
 
 __all__ = [
     "LinkMesh",
@@ -194,14 +195,6 @@ def _primitive(shape):
     return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64)
 
 
-def _bvh_mesh(bvh) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Vertices (scaled) and triangles of the mesh Pinocchio read (a coal BVH model)."""
-    V = np.asarray(bvh.vertices(), dtype=float)
-    F = np.array([[t[0], t[1], t[2]] for t in map(bvh.tri_indices, range(bvh.num_tris))],
-                 dtype=np.int64).reshape(-1, 3)  # fmt: skip
-    return V, F
-
-
 def _geometry_meshes(
     objects, links, placements, joints, max_faces: int, own_colors: bool = True
 ) -> list[LinkMesh]:
@@ -217,7 +210,7 @@ def _geometry_meshes(
             try:
                 V, F, C = _read_mesh(obj.meshPath, np.asarray(obj.meshScale, dtype=float))
             except (ImportError, ValueError, OSError):  # a format trimesh cannot read (a
-                V, F = _bvh_mesh(obj.geometry)  # .dae without pycollada): Pinocchio's copy
+                V, F = bvh_mesh(obj.geometry)  # .dae without pycollada): Pinocchio's copy
                 C = np.tile(COLLISION_RGB, (len(F), 1))
             if not own_colors:
                 C = np.tile(COLLISION_RGB, (len(F), 1))

@@ -25,13 +25,13 @@ A body's frame is centred on the smallest ball around its hull (trimesh's
 the largest distance of a hull vertex from that centre. Every speed bound of
 :mod:`kcplan.arm.bounds` holds for the ball, hence for the hull inside it.
 
-This module reads meshes; it imports neither OMPL nor FCL.
+This module computes hulls of given points (and caches them); it imports neither OMPL nor
+FCL.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,7 +47,6 @@ __all__ = [
     "cached_hull_pieces",
     "cylinder_hull",
     "hull_pieces",
-    "mesh_hull",
     "points_hull",
 ]
 
@@ -151,30 +150,6 @@ def points_hull(
         np.ascontiguousarray(vertices), np.asarray(hull.faces, dtype=np.int64), radius, delta
     )
     return centre, hull_out
-
-
-def mesh_hull(path: str | os.PathLike, scale: float = 1.0) -> tuple[NDArray[np.float64], BodyHull]:
-    """:func:`points_hull` of the vertices of the mesh in ``path`` (STL, OBJ, DAE, ...)
-    times ``scale``: it contains every triangle of the mesh, open or closed.
-
-    Raises
-    ------
-    ValueError
-        One line naming the file: not readable, or no volume.
-    """
-    import trimesh
-
-    source = os.fspath(path)
-    try:
-        mesh = trimesh.load(source, force="mesh", process=False)
-        points = np.asarray(mesh.vertices, dtype=float) * float(scale)
-    except Exception as err:  # trimesh raises many kinds for a file it cannot read
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise ValueError(f"{source}: expected a readable mesh, got: {first}") from None
-    try:
-        return points_hull(points)
-    except ValueError as err:
-        raise ValueError(f"{source}: {err}") from None
 
 
 def box_hull(half: NDArray[np.float64]) -> tuple[NDArray[np.float64], BodyHull]:

@@ -51,7 +51,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull, mesh_hull
+from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull
+from kcplan.arm.shapes import bvh_mesh
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
@@ -492,17 +493,11 @@ def hull_bodies(
         pieces = [box_hull(np.asarray(shape.halfSide, dtype=float))]
     elif kind == "Cylinder":
         pieces = [cylinder_hull(float(shape.radius), float(shape.halfLength))]
-    elif obj.meshPath or hasattr(shape, "vertices"):  # a file, or triangles (a held mesh)
+    elif hasattr(shape, "vertices"):  # a mesh: Pinocchio's BVH model of a file, or a held mesh
         start = time.perf_counter()
-        try:  # the mesh Pinocchio read (any format assimp reads, already scaled)
-            if hasattr(shape, "vertices"):
-                triangles = np.array([[t[0], t[1], t[2]] for t in map(shape.tri_indices,
-                                      range(shape.num_tris))], dtype=np.int64)  # fmt: skip
-                vertices = np.asarray(shape.vertices(), dtype=float)
-                pieces, _ = cached_hull_pieces(vertices, triangles, _single_precision(vertices))
-            else:  # pragma: no cover - buildGeomFromUrdf makes every mesh a BVH model
-                scale = np.asarray(obj.meshScale, dtype=float)
-                pieces = [mesh_hull(obj.meshPath, float(scale[0]))]
+        vertices, triangles = bvh_mesh(shape)  # any format assimp reads, already scaled
+        try:
+            pieces, _ = cached_hull_pieces(vertices, triangles, _single_precision(vertices))
         except ValueError as err:
             raise ArmError(f"{source}: collision: {obj.name}: {obj.meshPath}: {err}") from None
         took = time.perf_counter() - start

@@ -4,16 +4,18 @@ checker of :mod:`kcplan.planning.pin_checker`, attached objects of :mod:`kcplan.
 Obstacles become the same solids as in :func:`kcplan.world.collision.fcl_obstacle_parts`:
 a box a coal ``Box`` at its pose, a sphere a ``Sphere``, a cylinder a ``Cylinder`` (axis
 along its local z), an ellipsoid an ``Ellipsoid``, a convex obstacle the coal ``Convex``
-hull of its vertices, a mesh a ``BVHModelOBBRSS`` of its triangles.
+hull of its vertices, a mesh a ``BVHModelOBBRSS`` of its triangles. :func:`bvh_mesh`
+reads such a model (or one Pinocchio loaded from a URDF) back as arrays.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from kcplan.world.scenario import Obstacle
 
-__all__ = ["coal_obstacle"]
+__all__ = ["bvh_mesh", "coal_obstacle"]
 
 
 def coal_obstacle(ob: Obstacle):
@@ -58,3 +60,11 @@ def coal_obstacle(ob: Obstacle):
         return model, pin.SE3.Identity()
     raise ValueError(f"{ob.label}: expected a 3D obstacle kind, got {ob.kind!r}")
 
+
+def bvh_mesh(bvh) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The vertices ``(v, 3)`` (as stored: scaled, in the model's frame) and triangles
+    ``(t, 3)`` of a coal BVH model."""
+    V = np.asarray(bvh.vertices(), dtype=float).reshape(-1, 3)
+    F = np.array([[t[0], t[1], t[2]] for t in map(bvh.tri_indices, range(bvh.num_tris))],
+                 dtype=np.int64).reshape(-1, 3)  # fmt: skip
+    return V, F

@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 
 from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
 from kcplan.arm.model import ArmModel
+from kcplan.arm.shapes import bvh_mesh
 from kcplan.world.collision import fcl_obstacle_parts
 from kcplan.world.scenario import Obstacle
 
@@ -114,9 +115,8 @@ def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
 def _bvh(shape) -> tuple[fcl.BVHModel, float]:
     """A coal BVH model's triangles as an FCL BVH model, and its farthest vertex's
     distance from its origin."""
-    V = np.asarray(shape.vertices(), dtype=float)
-    F = np.array([[t[0], t[1], t[2]] for t in map(shape.tri_indices, range(shape.num_tris))],
-                 dtype=np.int32).reshape(-1, 3)  # fmt: skip
+    V, F = bvh_mesh(shape)
+    F = F.astype(np.int32)
     model = fcl.BVHModel()
     model.beginModel(len(V), len(F))
     model.addSubModel(V, F)
