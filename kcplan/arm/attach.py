@@ -76,15 +76,15 @@ def attach(arm: ArmModel, objects: Sequence[Attached]) -> ArmModel:
         if obj.name in names:
             raise ArmError(f"{arm.urdf}: attached.{obj.name}: the name is a link's or taken")
         names.add(obj.name)
-        frame = model.frames[model.getFrameId(obj.link, pin.FrameType.BODY)]
+        frame_id = model.getFrameId(obj.link, pin.FrameType.BODY)
+        frame = model.frames[frame_id]
         try:
             shape, pose = coal_obstacle(obj.shape)
         except ValueError as err:
             raise ArmError(f"{arm.urdf}: attached.{obj.name}: {err}") from None
         placement = frame.placement * pose  # in the frame of the link's joint
         index = geometry.addGeometryObject(
-            pin.GeometryObject(obj.name, int(frame.parentJoint), model.getFrameId(obj.link,
-                               pin.FrameType.BODY), placement, shape)  # fmt: skip
+            pin.GeometryObject(obj.name, int(frame.parentJoint), frame_id, placement, shape)
         )
         allowed = {obj.link, *obj.touch}
         for other, item in enumerate(geometry.geometryObjects[:index]):
