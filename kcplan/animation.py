@@ -96,6 +96,7 @@ def animate_arm(
     show_cover: bool = False,
     meshes: str = "auto",
     max_faces: int = 400,
+    timed: bool = False,
 ) -> int:
     """Write a GIF of an arm moving along a path through its scene.
 
@@ -121,6 +122,9 @@ def animate_arm(
         Draw the covering ellipsoids on the moving arm too.
     meshes : {"auto", "visual", "collision"}
     max_faces : int
+    timed : bool
+        ``states`` are a trajectory sampled at ``fps`` (one frame each, so that the GIF
+        plays in real time), not a path to interpolate.
 
     Returns
     -------
@@ -135,7 +139,7 @@ def animate_arm(
     links, _ = arm_meshes(arm, meshes, max_faces)
     ghosts, _ = arm_meshes(arm, "collision", max(max_faces // 4, 50))  # closed, coarse
     cover = cover_meshes(arm, 1) if show_cover else []
-    dense = joint_path(states, max(frames - 1, 1))
+    dense = np.asarray(states, dtype=float) if timed else joint_path(states, max(frames - 1, 1))
     along = joint_frames_along(arm, dense)
     ends = joint_frames_along(arm, [scenario.start, scenario.goal])
     ghosts = [m for m in ghosts if m.joint != 0]  # the fixed links are drawn moving

@@ -183,6 +183,7 @@ def write_scene_html(
     states=None,
     show_cover: bool = False,
     meshes: str = "auto",
+    frame_ms: float | None = None,
 ) -> str:
     """Write the scene as one self-contained HTML file (plotly.js embedded; works
     offline), atomically.
@@ -196,6 +197,9 @@ def write_scene_html(
     (:func:`arm_view_data`, in the ``<script id="kcplan-arm-data">`` block), so each mesh
     is stored once.
 
+    With ``frame_ms`` (an arm), ``states`` are a trajectory sampled every ``frame_ms``
+    milliseconds, one frame each, and the page plays them at that pace: in real time.
+
     Returns
     -------
     str
@@ -203,7 +207,8 @@ def write_scene_html(
     """
     scenario = as_scenario(scenario)
     if getattr(scenario, "arm", None) is not None:
-        data = arm_view_data(scenario, states, meshes=meshes)
+        data = arm_view_data(scenario, states, meshes=meshes, timed=frame_ms is not None)
+        data["frame_ms"] = 80 if frame_ms is None else float(frame_ms)
         write_text_atomic(path, arm_html(scenario, data, show_cover))
         return data["source"]
     html = scene_figure(scenario, states).to_html(include_plotlyjs=True, full_html=True)
@@ -348,7 +353,7 @@ _ARM_SCRIPT = """
     timer = setInterval(function () {
       if (current < last) { show(current + 1); return; }
       clearInterval(timer); timer = null; button.textContent = 'play';
-    }, 80);
+    }, D.frame_ms);
   });
 })();
 """.replace("@DATA_ID@", _ARM_DATA_ID)
@@ -378,7 +383,12 @@ def _mesh_data(mesh) -> dict:
 
 
 def arm_view_data(
-    scenario, states=None, frames: int = 60, meshes: str = "auto", max_faces: int = 2000
+    scenario,
+    states=None,
+    frames: int = 60,
+    meshes: str = "auto",
+    max_faces: int = 2000,
+    timed: bool = False,
 ) -> dict:
     """What the page of an arm holds (:func:`write_scene_html`): the meshes, the covering
     ellipsoids and the joint frames of every animation frame.
@@ -394,6 +404,8 @@ def arm_view_data(
         Which of the URDF's meshes draw the links (:func:`kcplan.arm_view.arm_meshes`).
     max_faces : int
         Triangles per link mesh at most.
+    timed : bool
+        ``states`` are a sampled trajectory: one frame each, not interpolated.
 
     Returns
     -------
@@ -410,7 +422,7 @@ def arm_view_data(
 
     arm = scenario.arm
     if states is not None and len(states):
-        path = joint_path(states, max(frames - 1, 1))
+        path = np.asarray(states, dtype=float) if timed else joint_path(states, max(frames - 1, 1))
         last = len(path) - 1
         labels = [f"frame {k} of {last}" + (" (start)" if k == 0 else " (goal)" if k == last
                   else "") for k in range(len(path))]  # fmt: skip

@@ -553,3 +553,46 @@ def plot_arm(
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=0.9, wspace=0.0)
     save_figure(fig, path, dpi=dpi)
     return source
+
+
+def plot_joint_velocities(trajectory, path: str | os.PathLike, rate: float = 1000.0) -> None:
+    """Plot a timed trajectory's joint velocities and accelerations against their limits
+    (one panel each, every joint, the limits dashed), sampled at ``rate`` per second.
+
+    Parameters
+    ----------
+    trajectory : kcplan.planning.trajectory.CertifiedTrajectory
+    path : path-like
+        The ``.png`` file, written atomically.
+    rate : float
+        Samples per second drawn.
+    """
+    timed = trajectory.timed
+    t, _, _, qd, qdd = timed.sample(rate)
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    colours = plt.get_cmap("tab10")
+    for ax, values, limits, unit in (
+        (axes[0], qd, timed.velocity_limits, "velocity (rad/s)"),
+        (axes[1], qdd, timed.acceleration_limits, "acceleration (rad/s²)"),
+    ):
+        for j, name in enumerate(trajectory.joints):
+            colour = colours(j % 10)
+            ax.plot(t, values[:, j], color=colour, lw=1.0, label=name)
+            ax.axhline(limits[j], color=colour, lw=0.6, ls="--")
+            ax.axhline(-limits[j], color=colour, lw=0.6, ls="--")
+        ax.set_ylabel(unit)
+        ax.grid(alpha=0.3)
+    rv, ra = timed.peak_ratios()
+    axes[0].set_title(
+        f"{timed.duration:.2f} s ({trajectory.stop_duration:.2f} s stopping at every corner); "
+        f"peaks {rv:.3f} and {ra:.3f} of the limits (dashed)",
+        fontsize=9,
+    )
+    axes[1].set_xlabel("time (s)")
+    axes[0].legend(fontsize=7, ncol=4, loc="upper right")
+    fig.tight_layout()
+    try:
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, dpi=90, format="png")
+    finally:
+        plt.close(fig)

@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 
 import fcl
 import numpy as np
 import trimesh
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
 from kcplan.arm.model import ArmModel
@@ -249,18 +249,35 @@ class ArmMeshChecker:
         """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints`
         order) without gaps; ``max_queries`` distance queries per segment at most
         (RuntimeError beyond)."""
-        queries, lowest = 0, math.inf
         states = [np.asarray(q, dtype=float) for q in states]
-        for index, (q1, q2) in enumerate(zip(states[:-1], states[1:], strict=True)):
-            dq = np.abs(q2 - q1)
-            speeds = np.concatenate([self._rho @ dq, self._rho_pairs @ dq])
+        pieces = [
+            (lambda s, q1=q1, dq=q2 - q1: q1 + s * dq, np.abs(q2 - q1))
+            for q1, q2 in zip(states[:-1], states[1:], strict=True)
+        ]
+        return self.check_pieces(pieces, max_queries)
+
+    def check_pieces(
+        self,
+        pieces: Sequence[tuple[Callable[[float], NDArray[np.float64]], NDArray[np.float64]]],
+        max_queries: int = 1_000_000,
+    ) -> ArmPathCheck:
+        """Check a curve without gaps, given as pieces ``(f, bound)``: ``f(s)``, ``s`` in
+        ``[0, 1]``, is a joint vector within the limits and ``bound[j]`` bounds ``|df_j /
+        ds|`` over the piece (a straight segment: ``|q2 - q1|``; any curve:
+        :meth:`kcplan.trajectory.curve.BlendedPath.pieces`). The chain's bound then holds
+        with ``bound`` in place of ``|dq|``: a point of a link moves at most ``rho @ bound``
+        per unit of ``s``. ``where`` names the piece."""
+        queries, lowest = 0, math.inf
+        for index, (at, bound) in enumerate(pieces):
+            bound = np.asarray(bound, dtype=float)
+            speeds = np.concatenate([self._rho @ bound, self._rho_pairs @ bound])
             horizon = np.zeros(len(speeds))
             budget = queries + max_queries
             while horizon.size:
                 s = float(horizon.min())
                 if s > 1.0:
                     break
-                self._place(q1 + s * (q2 - q1))
+                self._place(at(s))
                 for item in np.flatnonzero(horizon <= s):
                     d = self._distance(int(item))
                     queries += 1

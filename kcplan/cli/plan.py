@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 
 from kcplan.cli.common import InputError, load_input, output_file, planner_name, positive_float
 
@@ -30,8 +31,11 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.plot, "--plot", (".png",))
     output_file(args.animate, "--animate", (".gif",))
     output_file(args.html, "--html", (".html",))
+    output_file(args.trajectory, "--trajectory", (".json", ".csv"))
+    output_file(args.velocity_plot, "--velocity-plot", (".png",))
     scenario = load_input(args.scenario)
     arm = getattr(scenario, "arm", None) is not None
+    limits = _trajectory_limits(args, scenario, arm)
     if arm and args.guards:
         raise InputError(
             f"{args.scenario}: --guards: not available for arms (their edges are certified "
@@ -54,7 +58,10 @@ def run(args: argparse.Namespace) -> int:
         check_planner_name(args.planner, arm=arm)
     except ValueError as err:
         raise InputError(f"{args.scenario}: --planner: {err}") from None
-    result = plan(scenario, args.planner, args.time, args.seed, args.simplify)
+    velocity, acceleration = limits if limits is not None else (None, None)
+    result = plan(scenario, args.planner, args.time, args.seed, args.simplify,
+                  trajectory=limits is not None, velocity_limits=velocity,
+                  acceleration_limits=acceleration)  # fmt: skip
     status = "solved" if result.solved else "NOT solved"
     print(
         f"{scenario.name}: {status} by {args.planner} in {result.time:.3f} s "
@@ -68,6 +75,9 @@ def run(args: argparse.Namespace) -> int:
 
         write_text_atomic(args.output, json.dumps(result.to_json(), indent=1) + "\n")
         print(f"path written to {args.output}")
+    timed = result.trajectory
+    if timed is not None:
+        _write_trajectory(args, timed)
     if args.plot and arm:
         from kcplan.viz import plot_arm
 
@@ -92,9 +102,13 @@ def run(args: argparse.Namespace) -> int:
     if args.animate and result.solved and arm:
         from kcplan.animation import animate_arm
 
-        frames = animate_arm(scenario, result.states, args.animate,
+        states, fps = result.states, 10
+        if timed is not None:  # in real time: one frame every 1 / fps seconds
+            states = timed.timed.sample(fps)[2]
+        frames = animate_arm(scenario, states, args.animate,
                              title=f"{scenario.name}: {args.planner}",
-                             show_cover=args.show_cover, meshes=args.meshes)  # fmt: skip
+                             show_cover=args.show_cover, meshes=args.meshes,
+                             fps=fps, timed=timed is not None)  # fmt: skip
         print(f"animation written to {args.animate} ({frames} frames)")
     elif args.animate and result.solved:
         from kcplan.animation import animate_path
@@ -107,10 +121,67 @@ def run(args: argparse.Namespace) -> int:
         from kcplan.html_view import write_scene_html
 
         states = result.states if result.solved else None
-        source = write_scene_html(scenario, args.html, states, args.show_cover, args.meshes)
+        frame_ms = None
+        if timed is not None:  # in real time: 25 frames a second
+            states, frame_ms = timed.timed.sample(25.0)[2], 40
+        source = write_scene_html(scenario, args.html, states, args.show_cover, args.meshes,
+                                  frame_ms=frame_ms)  # fmt: skip
         links = f" (links: {source})" if source else ""
         print(f"interactive view written to {args.html}{links}")
     return 0 if result.solved else 1
+
+
+def _trajectory_limits(args: argparse.Namespace, scenario, arm: bool):
+    """``(velocity limits, acceleration limits)`` for ``--trajectory``, checked before
+    planning (None without it)."""
+    wants = args.trajectory or args.velocity_plot
+    if not wants:
+        if args.acceleration_limit is not None:
+            raise InputError(f"{args.scenario}: --acceleration-limit: only with --trajectory")
+        return None
+    if not arm:
+        raise InputError(f"{args.scenario}: --trajectory: only for arms (a URDF robot); a "
+                         "rigid robot's path is not timed yet")  # fmt: skip
+    if not args.planner.startswith(("kc-", "ca-")):
+        raise InputError(f"{args.scenario}: --trajectory: expected a kc-* or ca-* planner, "
+                         f"whose edges are certified, got {args.planner}")  # fmt: skip
+    from kcplan.planning.trajectory import joint_limits
+
+    given = None
+    if args.acceleration_limit is not None:
+        try:
+            given = [float(x) for x in args.acceleration_limit.split(",")]
+        except ValueError:
+            given = [math.nan]
+        given = given[0] if len(given) == 1 else given
+    try:
+        return joint_limits(scenario.arm, None, given)
+    except ValueError as err:
+        flag = "--acceleration-limit" if "acceleration" in str(err) else "robot.urdf"
+        raise InputError(f"{args.scenario}: {flag}: {err}") from None
+
+
+def _write_trajectory(args: argparse.Namespace, timed) -> None:
+    """``--trajectory`` (JSON or CSV) and ``--velocity-plot``, and a line about each."""
+    from kcplan.files import write_text_atomic
+
+    t = timed.timed
+    rv, ra = t.peak_ratios()
+    print(f"trajectory      : {t.duration:.3f} s ({timed.stop_duration:.3f} s stopping at "
+          f"every corner), {timed.certificate.summary()['blends']} certified blends, peak "
+          f"{rv:.3f} of the velocity and {ra:.3f} of the acceleration limits, smoothed and "
+          f"timed in {timed.seconds:.3f} s")  # fmt: skip
+    if args.trajectory:
+        if args.trajectory.lower().endswith(".csv"):
+            write_text_atomic(args.trajectory, timed.csv(args.rate))
+        else:
+            write_text_atomic(args.trajectory, json.dumps(timed.document(args.rate)) + "\n")
+        print(f"trajectory written to {args.trajectory} ({args.rate:g} samples a second)")
+    if args.velocity_plot:
+        from kcplan.viz import plot_joint_velocities
+
+        plot_joint_velocities(timed, args.velocity_plot)
+        print(f"joint velocities plotted in {args.velocity_plot}")
 
 
 def path_guards(scenario, states) -> list:
@@ -166,6 +237,31 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--html",
         metavar="FILE.html",
         help="write an interactive 3D view (one self-contained HTML file, works offline)",
+    )
+    p.add_argument(
+        "--trajectory",
+        metavar="TRAJ.json",
+        help="arms, kc-*/ca-* planners: smooth the path with certified blends, time it "
+        "within the joint limits (TOPP-RA) and write it sampled (.json, or .csv); "
+        "--animate and --html then play it in real time",
+    )
+    p.add_argument(
+        "--rate",
+        type=positive_float,
+        default=100.0,
+        metavar="HZ",
+        help="samples per second of --trajectory (default 100)",
+    )
+    p.add_argument(
+        "--acceleration-limit",
+        metavar="A[,A...]",
+        help="joint acceleration limits of --trajectory, rad/s^2: one for every joint or one "
+        "per joint (default: twice each joint's URDF velocity limit per second)",
+    )
+    p.add_argument(
+        "--velocity-plot",
+        metavar="FILE.png",
+        help="plot the trajectory's joint velocities and accelerations against their limits",
     )
     add_arm_view_options(p)
     p.set_defaults(handler=run)

@@ -99,6 +99,7 @@ __all__ = [
     "PROBE_STEP",
     "ArmEdgeCertifier",
     "ArmGuard",
+    "stretch_radii",
 ]
 
 ARM_COUNTER_NAMES = tuple(
@@ -274,7 +275,7 @@ class ArmEdgeCertifier:
             w, velocity = twists(self.arm, guard.state, step)
             if self.first_order:
                 twist = (twist_speeds(self.arm, w, velocity), accel)
-        bodies = _reaches(guard.scene, speed, L @ dq, growth, twist)
+        bodies = stretch_radii(guard.scene, speed, L @ dq, growth, twist)
         if guard.grown is not None:
             rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
             kc = _kc_reaches(
@@ -286,7 +287,7 @@ class ArmEdgeCertifier:
         if self.first_order:
             pairs = self.world.self_pairs
             pair_twist = (relative_first_order(self.arm, guard.state, step, pairs), pair_accel)
-        pairs = _reaches(guard.pairs, pair_speed, pair_levers @ dq, pair_growth, pair_twist)
+        pairs = stretch_radii(guard.pairs, pair_speed, pair_levers @ dq, pair_growth, pair_twist)
         r = min(bodies.min(initial=math.inf), pairs.min(initial=math.inf))
         return r * (1.0 - 1e-9)  # the open stretch, with a margin for rounding
 
@@ -366,7 +367,7 @@ def _length(dq: np.ndarray) -> float:
     return math.sqrt(sum(float(d) * float(d) for d in dq))
 
 
-def _reaches(
+def stretch_radii(
     d: np.ndarray, v: np.ndarray, A: np.ndarray, Q: np.ndarray, twist: tuple | None = None
 ) -> np.ndarray:
     """The radius clearances ``d`` give to each part of global speed ``v``, lever term

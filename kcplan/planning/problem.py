@@ -304,6 +304,10 @@ class PlanResult:
     joints: tuple[str, ...] | None = None
     """An arm's planning group: ``states`` are joint vectors in this order (else None:
     flat poses)."""
+    trajectory: object = field(default=None, repr=False, compare=False)
+    """An arm's :class:`kcplan.planning.trajectory.CertifiedTrajectory` along the path,
+    when :func:`plan` was asked for it (``trajectory=True``); not written to JSON (its own
+    file: :meth:`~kcplan.planning.trajectory.CertifiedTrajectory.document`)."""
 
     def verify(self, tolerance: float = 1e-6) -> PathCheck:
         """Check the path without gaps, independently of every certificate
@@ -353,6 +357,9 @@ def plan(
     world: CollisionWorld | None = None,
     first_solution: bool = False,
     progress: float | None = None,
+    trajectory: bool = False,
+    velocity_limits=None,
+    acceleration_limits=None,
 ) -> PlanResult:
     """Plan a path for the scenario's robot from start to goal.
 
@@ -381,6 +388,13 @@ def plan(
         Record the best cost every ``progress`` seconds while solving (planners for which
         :func:`kcplan.planning.progress.reports_progress` holds: RRT*, Informed RRT*,
         SORRT*, AORRTC, BIT*; ignored for the others).
+    trajectory : bool
+        An arm only, with a ``kc-*`` or ``ca-*`` planner (whose edges are certified):
+        smooth the path with certified blends and time it within the joint limits
+        (:func:`kcplan.planning.trajectory.certified_trajectory`), as
+        ``PlanResult.trajectory``.
+    velocity_limits, acceleration_limits : optional
+        The trajectory's limits (:func:`kcplan.planning.trajectory.joint_limits`).
 
     Returns
     -------
@@ -394,11 +408,17 @@ def plan(
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     scenario = as_scenario(scenario)
+    if trajectory and not isinstance(scenario, ArmScenario):
+        raise ValueError("trajectory: only for arms (a URDF robot); a rigid robot's path "
+                         "is not timed yet")  # fmt: skip
     try:  # the arm-only planners refuse a rigid robot
         check_planner_name(planner, arm=isinstance(scenario, ArmScenario))
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     spec = PLANNERS[planner]
+    if trajectory and not spec.kc:
+        raise ValueError(f"trajectory: expected a kc-* or ca-* planner, whose edges are "
+                         f"certified; {planner} checks them at samples")  # fmt: skip
     if seed is not None:
         seed_ompl(seed)
     checker_calls = [0]
@@ -478,6 +498,12 @@ def plan(
         }
         if validator is not None:
             counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
+        timed = None  # after the counters: they are the planner's
+        if solved and trajectory:
+            from kcplan.planning.trajectory import certified_trajectory
+
+            timed = certified_trajectory(setup.world, states, velocity_limits,
+                                         acceleration_limits)  # fmt: skip
     finally:
         if validator is not None:
             validator.close()
@@ -498,6 +524,7 @@ def plan(
         recorder.first_solution_time if recorder is not None else None,
         setup.backend,
         setup.joints,
+        timed,
     )
 
 
