@@ -11,15 +11,19 @@ import numpy as np
 from kcplan.cli.common import InputError, load_input, positive_float
 
 
-def _read_path(path: str, scenario) -> np.ndarray:
-    """The path file's states, checked against the scenario (poses, or an arm's joint
-    vectors in its ``joints`` order)."""
+def _read_json(path: str) -> dict:
     try:
         data = json.loads(Path(path).read_text())
     except OSError as err:
         raise InputError(f"{path}: cannot read the file: {err.strerror or err}") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise InputError(f"{path}: expected a JSON path file, got invalid JSON ({err})") from None
+    return data
+
+
+def _read_path(path: str, scenario, data: dict) -> np.ndarray:
+    """The path file's states, checked against the scenario (poses, or an arm's joint
+    vectors in its ``joints`` order)."""
     if not isinstance(data, dict) or "states" not in data:
         raise InputError(f"{path}: states: expected a JSON object with a 'states' list")
     arm = getattr(scenario, "arm", None)
@@ -55,7 +59,10 @@ def _read_path(path: str, scenario) -> np.ndarray:
 def run(args: argparse.Namespace) -> int:
     """Verify the path file against the scenario; exit 1 on a collision."""
     scenario = load_input(args.scenario)
-    states = _read_path(args.path, scenario)
+    data = _read_json(args.path)
+    if isinstance(data, dict) and "curve" in data and "states" not in data:
+        return _verify_trajectory(args, scenario, data)
+    states = _read_path(args.path, scenario, data)
     if getattr(scenario, "arm", None) is not None:
         return _verify_arm(args, scenario, states)
     from kcplan.planning.verify import verify_path
@@ -107,6 +114,65 @@ def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
     return 0
 
 
+LIMIT_TOLERANCE = 1e-6
+"""Relative: a sample's speed or acceleration up to this much above its limit passes."""
+CURVE_TOLERANCE = 1e-9
+"""Radians: a sample this far from the curve at its ``s`` is still on it."""
+
+
+def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
+    """A trajectory file of ``kcplan plan --trajectory``: its continuous curve on the
+    links' own meshes (every piece, without gaps, :meth:`kcplan.arm.verify.ArmMeshChecker.
+    check_pieces`), every sample on that curve and within the limits it states."""
+    arm = getattr(scenario, "arm", None)
+    if arm is None:
+        raise InputError(f"{args.path}: curve: a trajectory file is an arm's; "
+                         f"{args.scenario} has a rigid robot")  # fmt: skip
+    if args.mesh is not None:
+        raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
+    from kcplan.arm.verify import ArmMeshChecker
+    from kcplan.planning.trajectory import read_trajectory
+
+    if data.get("joints") != list(arm.joints):
+        raise InputError(f"{args.path}: joints: expected the scenario's planning group "
+                         f"{list(arm.joints)}, got {data.get('joints')!r}")  # fmt: skip
+    try:
+        file = read_trajectory(data, arm.dof)
+    except ValueError as err:
+        raise InputError(f"{args.path}: {err}") from None
+    outside = [k for k, q in enumerate(file.path.waypoints) if not arm.within_limits(q)]
+    if outside:
+        raise InputError(f"{args.path}: curve.waypoints[{outside[0]}]: expected joint values "
+                         "within the limits")  # fmt: skip
+    off = file.deviations()
+    problems = []
+    if off["curve"] > CURVE_TOLERANCE:
+        problems.append(f"a sample is {off['curve']:.3g} rad off the curve")
+    if off["velocity"] > 1 + LIMIT_TOLERANCE:
+        problems.append(f"a joint speed reaches {off['velocity']:.6f} of its limit")
+    if off["acceleration"] > 1 + LIMIT_TOLERANCE:
+        problems.append(f"a joint acceleration reaches {off['acceleration']:.6f} of its limit")
+    if off["time"] <= 0 or off["parameter"] < 0:
+        problems.append("the samples do not move forward in time and along the curve")
+    checker = ArmMeshChecker(arm, scenario.obstacles, scenario.allowed, args.tolerance)
+    check = checker.check_pieces(file.path.pieces())
+    pieces = len(file.path.breakpoints) - 1
+    if check.collides:
+        piece, s = check.where
+        problems.append(f"COLLISION of the links' meshes ({check.what}) on piece {piece} of "
+                        f"the curve at {s:.6f} of it")  # fmt: skip
+    if problems:
+        print("; ".join(problems) + f" ({check.queries} distance queries)")
+        return 1
+    print(f"clean: the links' meshes along the whole curve ({pieces} pieces, "
+          f"{int((file.path.blends > 0).sum())} blends) checked without gaps, minimum "
+          f"clearance {check.min_clearance:.6g}, {check.queries} distance queries; "
+          f"{len(file.t)} samples on the curve (within {off['curve']:.1g} rad), peaks "
+          f"{off['velocity']:.6f} of the velocity and {off['acceleration']:.6f} of the "
+          "acceleration limits")  # fmt: skip
+    return 0
+
+
 def _part_world(args: argparse.Namespace, scenario, world):
     """The part of ``--mesh`` (the scenario's own mesh when given without a file)."""
     from kcplan.world.part import PartWorld
@@ -143,7 +209,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "clean, 1 collision, 2 bad input.",
     )
     p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
-    p.add_argument("path", metavar="PATH.json", help="path file written by kcplan plan")
+    p.add_argument(
+        "path",
+        metavar="PATH.json",
+        help="path file written by kcplan plan (-o), or a trajectory file (--trajectory): "
+        "then its continuous curve, and its samples against the curve and the limits",
+    )
     p.add_argument(
         "--tolerance",
         type=positive_float,

@@ -195,3 +195,85 @@ def certified_trajectory(
     seconds = time.perf_counter() - start
     stop = time_path(BlendedPath(W), v, a).duration
     return CertifiedTrajectory(tuple(arm.joints), timed, certificate, stop, seconds, len(W) - 1)
+
+
+@dataclass(frozen=True)
+class TrajectoryFile:
+    """A trajectory file read back (:func:`read_trajectory`): its curve and its samples."""
+
+    joints: tuple[str, ...]
+    path: BlendedPath
+    t: NDArray[np.float64]
+    s: NDArray[np.float64]
+    q: NDArray[np.float64]
+    qd: NDArray[np.float64]
+    qdd: NDArray[np.float64]
+    velocity_limits: NDArray[np.float64]
+    acceleration_limits: NDArray[np.float64]
+
+    def deviations(self) -> dict[str, float]:
+        """How far the samples are from the curve and the limits: ``curve`` (the largest
+        ``|q - curve(s)|``, rad), ``velocity`` and ``acceleration`` (the largest ``|qd_j| /
+        v_j`` and ``|qdd_j| / a_j``), ``time`` (the smallest step of ``t``, s) and
+        ``parameter`` (the smallest step of ``s``)."""
+        return {
+            "curve": float(np.abs(self.q - self.path(self.s)).max(initial=0.0)),
+            "velocity": float((np.abs(self.qd) / self.velocity_limits).max(initial=0.0)),
+            "acceleration": float((np.abs(self.qdd) / self.acceleration_limits).max(initial=0.0)),
+            "time": float(np.diff(self.t).min(initial=np.inf)),
+            "parameter": float(np.diff(self.s).min(initial=np.inf)),
+        }
+
+
+def read_trajectory(data: dict, dof: int) -> TrajectoryFile:
+    """A trajectory file's fields (:meth:`CertifiedTrajectory.document`), checked.
+
+    Raises
+    ------
+    ValueError
+        ``FIELD: expected ...`` for the first field that is missing or malformed.
+    """
+
+    def array(field: str, shape: tuple) -> NDArray[np.float64]:
+        try:
+            x = np.array(data[field], dtype=float)
+        except KeyError:
+            raise ValueError(f"{field}: expected the field (a trajectory file of kcplan plan "
+                             "--trajectory)") from None  # fmt: skip
+        except (TypeError, ValueError):
+            x = np.zeros(0)
+        if x.shape != shape or not np.isfinite(x).all():
+            raise ValueError(f"{field}: expected finite numbers of shape {shape}, got "
+                             f"{x.shape if x.size else 'none'}")  # fmt: skip
+        return x
+
+    curve = data.get("curve")
+    if not isinstance(curve, dict):
+        raise ValueError("curve: expected {waypoints, blends}: the certified curve")
+    try:
+        W = np.array(curve.get("waypoints"), dtype=float)
+        blends = np.array(curve.get("blends"), dtype=float)
+    except (TypeError, ValueError):
+        W = blends = np.zeros(0)
+    if W.ndim != 2 or W.shape[1:] != (dof,) or len(W) < 2 or not np.isfinite(W).all():
+        raise ValueError(f"curve.waypoints: expected at least two joint vectors of {dof} "
+                         "numbers")  # fmt: skip
+    try:
+        path = BlendedPath(W, blends)
+    except ValueError as err:
+        raise ValueError(f"curve.{err}") from None
+    t = np.array(data.get("t", []), dtype=float) if isinstance(data.get("t"), list) else None
+    if t is None or t.ndim != 1 or len(t) < 2:
+        raise ValueError("t: expected a list of at least two sample times (s)")
+    m = len(t)
+    return TrajectoryFile(
+        tuple(data.get("joints") or ()),
+        path,
+        array("t", (m,)),
+        array("s", (m,)),
+        array("q", (m, dof)),
+        array("qd", (m, dof)),
+        array("qdd", (m, dof)),
+        array("velocity_limits", (dof,)),
+        array("acceleration_limits", (dof,)),
+    )

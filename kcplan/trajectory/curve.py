@@ -39,6 +39,9 @@ __all__ = ["BlendedPath", "corner_directions"]
 TURN_FLOOR = 1e-12
 """A corner whose unit directions differ by less than this (in norm) is straight: it is
 neither blended nor kept as a kink."""
+BLEND_FLOOR = 1e-9
+"""Radians: a blend smaller than this is no blend (the corner is kept as a kink; a
+trajectory stops there, as it nearly would through so sharp a turn)."""
 
 
 def corner_directions(waypoints: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray]:
@@ -77,7 +80,8 @@ class BlendedPath:
     blends : array_like, shape (N - 2,), optional
         ``delta_i >= 0`` of each interior waypoint, in the joint space's length unit (rad);
         the two blends of a segment must fit on it (``delta_i + delta_{i+1} <=`` its length,
-        the end waypoints having none). Default: no blend (the polyline).
+        the end waypoints having none); one below :data:`BLEND_FLOOR` keeps its corner.
+        Default: no blend (the polyline).
     """
 
     def __init__(self, waypoints: ArrayLike, blends: ArrayLike | None = None) -> None:
@@ -89,13 +93,13 @@ class BlendedPath:
         if delta.shape != (len(W) - 2,) or not (delta >= 0).all():
             raise ValueError(f"blends: expected {len(W) - 2} numbers >= 0, got {delta.shape}")
         turns = np.linalg.norm(u2 - u1, axis=1)
-        delta = np.where(turns < TURN_FLOOR, 0.0, delta)  # a straight corner needs none
+        delta = np.where((turns < TURN_FLOOR) | (delta < BLEND_FLOOR), 0.0, delta)
         ends = np.concatenate([[0.0], delta, [0.0]])  # what each waypoint's blend takes
         straight = lengths - ends[:-1] - ends[1:]
         if (straight < -1e-12 * np.maximum(lengths, 1.0)).any():
             k = int(np.argmin(straight))
             raise ValueError(f"blends: the blends at both ends of segment {k} exceed its "
-                             f"length {lengths[k]!r}")  # fmt: skip
+                             f"length {float(lengths[k])!r}")  # fmt: skip
         units = np.diff(W, axis=0) / lengths[:, None]
         coefficients, breaks, self._kinks = [], [0.0], []
         for k in range(len(lengths)):

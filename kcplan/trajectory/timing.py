@@ -43,6 +43,12 @@ GRID_INTERVALS = 100
 """TOPP-RA gridpoints per section of the path (between kinks), spread by length, every
 breakpoint of the path among them and at least :data:`BLEND_INTERVALS` per blend."""
 BLEND_INTERVALS = 6
+SIDE = 1e-3
+"""A breakpoint where a blend meets a line has a gridpoint this share of the piece before
+it: TOPP-RA reads the path's derivatives at a gridpoint from the piece after it, so the
+interval ending there is constrained by its own piece's, up to a change of order SIDE
+(1e-7 made TOPP-RA's solver lose the constraint on so short an interval; 1e-2 needed a
+0.4 % slow-down; 1e-3 none, and 0.5 % shorter trajectories than without it)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,8 +160,10 @@ def _grid(path: BlendedPath, lo: float, hi: float, intervals: int) -> NDArray[np
         points = np.linspace(a, b, n + 1)[1:]
         if not path.curved[k]:
             h = min(step, b - a) * np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2])
-            points = np.unique(np.concatenate([points, a + h, b - h]))
-        out.append(points)
+            points = np.concatenate([points, a + h, b - h])
+        if k + 1 < len(path.curved) and path.curved[k] != path.curved[k + 1]:
+            points = np.append(points, b - SIDE * (b - a))  # the piece's own end (below)
+        out.append(np.unique(points))
     return np.concatenate(out)
 
 
