@@ -346,6 +346,21 @@ CASES.append(
 )
 
 
+CASES.append(
+    Case(  # one problem, one random corner: the table and a blend re-checked on the meshes
+        "trajectory_bench.py",
+        ("--per-class", "1", "--classes", "box", "--corners", "1", "--time", "5")
+        + ("-o", "{tmp}"),
+        (
+            r"^\| class \| solved / valid \| plan, median s \| smooth \+ time, median s \| ",
+            rf"^\| box \| 1 / 1 \| {NUMBER} \| {NUMBER} \| 0\.\d\d \| (0\.\d+|1\.000000), "
+            rf"(0\.\d+|1\.000000) \| 0 \| 1, 0, [01] \|$",
+        ),
+        ("trajectory_table.md", "rows.json", "scenarios/box_1.yaml"),
+    )
+)
+
+
 @pytest.mark.skipif(HAVE_VAMP, reason="VAMP is installed here")
 def test_vamp_mbm_without_vamp_says_how_to_build_it():
     proc = subprocess.run(
