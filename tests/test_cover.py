@@ -293,9 +293,7 @@ def _star_solid(seed: int) -> trimesh.Trimesh:
     return trimesh.Trimesh(ball.vertices * r[:, None], ball.faces)
 
 
-@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.integers(0, 2**31), st.integers(1, 5), st.booleans())
-def test_random_convex_and_star_solids_are_covered(tmp_path_factory, seed, bodies, convex):
+def _random_solid_is_covered(tmp_path_factory, seed, bodies, convex):
     rng = np.random.default_rng(seed)
     mesh = (
         trimesh.convex.convex_hull(rng.normal(size=(rng.integers(5, 40), 3)) * [3, 1, 0.3])
@@ -307,6 +305,19 @@ def test_random_convex_and_star_solids_are_covered(tmp_path_factory, seed, bodie
     solid = read_solid(path)
     cover = fit_cover(solid, bodies=bodies)
     _assert_covered(solid, cover, _mesh(path), 20_000, seed)
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**31), st.integers(1, 5), st.booleans())
+def test_random_convex_and_star_solids_are_covered(tmp_path_factory, seed, bodies, convex):
+    _random_solid_is_covered(tmp_path_factory, seed, bodies, convex)
+
+
+@pytest.mark.study
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**31), st.integers(1, 5), st.booleans())
+def test_random_convex_and_star_solids_are_covered_study(tmp_path_factory, seed, bodies, convex):
+    _random_solid_is_covered(tmp_path_factory, seed, bodies, convex)
 
 
 @settings(max_examples=25, deadline=None)
@@ -771,7 +782,10 @@ def _flipped_triangles() -> trimesh.Trimesh:
     return trimesh.Trimesh(ball.vertices, faces, process=False)
 
 
-@pytest.mark.parametrize("make", [_two_boxes, _inverted_capsule, _flipped_triangles])
+@pytest.mark.parametrize(
+    "make",
+    [_two_boxes, pytest.param(_inverted_capsule, marks=pytest.mark.study), _flipped_triangles],
+)
 def test_disjoint_inverted_and_badly_wound_meshes_are_covered(tmp_path, make):
     """CAD exports with several shells, inward normals or flipped triangles: the part is
     the same solid (only the winding is repaired), and its cover holds it."""
