@@ -361,6 +361,21 @@ CASES.append(
 )
 
 
+CASES.append(
+    Case(  # one table_pick problem: reach, carry the can, return; the view of all three
+        "pick_place_mbm.py",
+        ("--problems", "1", "--time", "5", "--html", "{tmp}/sequence.html", "-o", "{tmp}"),
+        (
+            r"^\| problem \| turn \(rad\) \| reach: solved, s \| carry: solved, s \| ",
+            rf"^\| table_pick_1 \| [+-]\d\.\d \| yes, {NUMBER} \| yes, {NUMBER} \| yes, "
+            rf"{NUMBER} \| 0 \|$",
+            r"^\| \*\*all\*\* \| 1 of 1 with a place \| sequences solved 1 / 1 \| ",
+        ),
+        ("pick_place_table.md", "sequence.html", "scenarios/table_pick_1_carry.yaml"),
+    )
+)
+
+
 @pytest.mark.skipif(HAVE_VAMP, reason="VAMP is installed here")
 def test_vamp_mbm_without_vamp_says_how_to_build_it():
     proc = subprocess.run(

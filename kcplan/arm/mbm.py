@@ -70,6 +70,9 @@ class MbmProblem:
         Every joint of the request's start state (fingers included).
     allowed : frozenset of frozenset of str
         Link pairs the scene's allowed collision matrix allows to touch.
+    names : tuple of str
+        The scene's ``id`` of each obstacle (an object of several primitives names each),
+        e.g. ``Can1``, the object a table_pick problem grasps.
     """
 
     obstacles: tuple[Obstacle, ...]
@@ -78,6 +81,7 @@ class MbmProblem:
     goal: np.ndarray
     start_state: dict
     allowed: frozenset
+    names: tuple[str, ...] = ()
 
 
 def _field(data, path: str, source: str):
@@ -89,8 +93,10 @@ def _field(data, path: str, source: str):
     return value
 
 
-def _obstacles(scene: dict, source: str) -> tuple[Obstacle, ...]:
+def _obstacles(scene: dict, source: str) -> tuple[tuple[Obstacle, ...], tuple[str, ...]]:
+    """The scene's obstacles and the ``id`` of the object each belongs to."""
     out: list[Obstacle] = []
+    names: list[str] = []
     objects = _field(scene, "world.collision_objects", source) or []
     for k, obj in enumerate(objects):
         where = f"world.collision_objects[{k}]"
@@ -98,6 +104,7 @@ def _obstacles(scene: dict, source: str) -> tuple[Obstacle, ...]:
         if len(primitives) != len(poses):
             raise MbmError(f"{source}: {where}: expected a pose per primitive")
         for shape, pose in zip(primitives, poses, strict=True):
+            names.append(str(obj.get("id", f"object{k}")))
             center = np.asarray(pose.get("position"), dtype=float)
             q = np.asarray(pose.get("orientation", [0, 0, 0, 1]), dtype=float)
             dims = np.asarray(shape.get("dimensions"), dtype=float)
@@ -125,7 +132,7 @@ def _obstacles(scene: dict, source: str) -> tuple[Obstacle, ...]:
                     f"{source}: {where}.primitives: expected a box, cylinder or sphere with "
                     f"positive dimensions, got {kind!r} {dims.tolist()}"
                 )
-    return tuple(out)
+    return tuple(out), tuple(names)
 
 
 def _allowed(scene: dict) -> frozenset:
@@ -157,9 +164,8 @@ def _problem(scene: dict, request: dict, scene_source: str, request_source: str)
         )
     start = np.array([start_state[j] for j in joints])
     goal = np.array([float(c["position"]) for c in constraints])
-    return MbmProblem(
-        _obstacles(scene, scene_source), joints, start, goal, start_state, _allowed(scene)
-    )
+    obstacles, names = _obstacles(scene, scene_source)
+    return MbmProblem(obstacles, joints, start, goal, start_state, _allowed(scene), names)
 
 
 def _load(text: str | bytes, source: str) -> dict:
