@@ -395,13 +395,9 @@ std::shared_ptr<const ArmGuard> ArmCertifier::endpoint(const double* q,
   return cache_.add_guard(key, measure(q, 1.0));  // this edge's whole length from this end
 }
 
-bool ArmCertifier::check(const double* q1, const double* q2) {
-  CertifierCounters& c = counters;
-  ++c.edges;
-  if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
-  if (!state_valid(q2)) return reject(c.rejected_end_state);
+void ArmCertifier::set_edge(const double* step) {
   const std::size_t dof = n_;
-  for (std::size_t j = 0; j < dof; ++j) step_[j] = q2[j] - q1[j], dq_[j] = std::abs(step_[j]);
+  for (std::size_t j = 0; j < dof; ++j) step_[j] = step[j], dq_[j] = std::abs(step[j]);
   for (std::size_t k = 0; k < speed_.size(); ++k) {
     double v = 0.0;
     for (std::size_t j = 0; j < dof; ++j) v += rho_[k * dof + j] * dq_[j];
@@ -434,6 +430,44 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
       group_growth_[g] = Q;
     }
   }
+}
+
+bool ArmCertifier::check_blend(const double* a, const double* c, const double* b,
+                               int max_guards) {
+  if (!chain_.admits(a) || !chain_.admits(c) || !chain_.admits(b)) return false;
+  for (int j = 0; j < n_; ++j)
+    q_[j] = 2.0 * std::max(std::abs(c[j] - a[j]), std::abs(b[j] - c[j]));
+  // the bounds of a curve: the speed and lever terms only (the class docs)
+  const bool first_order = first_order_;
+  const double kc = kc_;
+  first_order_ = false, kc_ = 0.0;
+  set_edge(q_.data());
+  std::vector<double> point(n_);
+  int guards = 0;
+  const Advanced outcome = advance(
+      0.0, 1.0, max_guards, pending_,
+      [&](double t, double s0, double s1, double& g_lo, double& g_hi) {
+        const double u = 1.0 - t;
+        for (int j = 0; j < n_; ++j) point[j] = u * u * a[j] + 2.0 * t * u * c[j] + t * t * b[j];
+        const double enough = 0.5 * (s1 - s0);
+        measure_into(point.data(), enough, scratch_);
+        const double r = radius(scratch_, enough);
+        if (r <= 0.0) return false;
+        g_lo = t - r, g_hi = t + r;
+        return true;
+      },
+      guards);
+  first_order_ = first_order, kc_ = kc;
+  return outcome == Advanced::kCovered;
+}
+
+bool ArmCertifier::check(const double* q1, const double* q2) {
+  CertifierCounters& c = counters;
+  ++c.edges;
+  if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
+  if (!state_valid(q2)) return reject(c.rejected_end_state);
+  for (int j = 0; j < n_; ++j) q_[j] = q2[j] - q1[j];
+  set_edge(q_.data());
   const ArmGuardCache::Key k1 = ArmGuardCache::key_of(q1, n_), k2 = ArmGuardCache::key_of(q2, n_);
   std::shared_ptr<const ArmGuard> g1 = cache_.guard(k1), g2 = cache_.guard(k2);
   double lo = 0.0, hi = 1.0;

@@ -127,6 +127,16 @@ class ArmCertifier {
 
   /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free.
   bool check(const double* q1, const double* q2);
+  /// Whether the quadratic Bezier blend B(t) = (1 - t)^2 a + 2 t (1 - t) c + t^2 b,
+  /// t in [0, 1] (a, c, b: dof() numbers each, within the limits), is proven free.
+  /// B'(t) = 2 ((1 - t) (c - a) + t (b - c)), so |B'_j(t)| <= bound_j = 2 max(|c_j - a_j|,
+  /// |b_j - c_j|) all along it; the chain's speed and lever bounds integrate |dq_j/dt|
+  /// along any curve in the joint box, so the radius (in t) a guard at B(t_m) gives the
+  /// straight edge of |dq| = bound holds for the curve, and guards placed by conservative
+  /// advancement in t (advance(), at most `max_guards`, not cached) prove it. The first
+  /// order and the KC guard are not used here: they need a straight edge's signed step.
+  /// kcplan/planning/smoothing.py has the proof and the Python twin.
+  bool check_blend(const double* a, const double* c, const double* b, int max_guards);
   /// State validity with the cache: one collision query for a state not seen before.
   bool state_valid(const double* q);
   /// One guard at q, not cached. With `enough` > 0 (during check()), each body's
@@ -169,6 +179,9 @@ class ArmCertifier {
 
  private:
   std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);
+  /// The current edge's terms from its signed joint step (step_, dq_, the speeds, growth,
+  /// accelerations, turns and the groups' terms): what radius() needs of an edge.
+  void set_edge(const double* step);
   bool reject(std::int64_t& reason);
   bool certified_by_endpoints();
   bool probe(const double* q1, const double* q2, double lo, double hi, double length);

@@ -418,6 +418,15 @@ NB_MODULE(_core, m) {
       .def("state_valid", [](kcplan::ArmCertifier& c, const std::vector<double>& q) {
         return c.state_valid(joints_of(c.world().chain(), q));
       }, "q"_a)
+      .def("check_blend", [](kcplan::ArmCertifier& c, const std::vector<double>& a,
+                             const std::vector<double>& corner, const std::vector<double>& b,
+                             int max_guards) {
+        const kcplan::Chain& chain = c.world().chain();
+        return c.check_blend(joints_of(chain, a), joints_of(chain, corner), joints_of(chain, b),
+                             max_guards);
+      }, "a"_a, "corner"_a, "b"_a, "max_guards"_a,
+      "Whether the quadratic Bezier blend through a, corner, b is proven free "
+      "(kcplan/_kernel/arm_certifier.hpp)")
       .def("measure", [](kcplan::ArmCertifier& c, const std::vector<double>& q) {
         const kcplan::ArmGuard g = c.measure(joints_of(c.world().chain(), q));
         return nb::make_tuple(g.clearance, g.scene, g.pairs);

@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from kcplan._kernel import ArmCertifier
 from kcplan.arm.bounds import carries, point_speeds, relative_speeds
 from kcplan.planning.arm_certifier import stretch_radii
 from kcplan.planning.certifier import advance
@@ -100,7 +101,9 @@ class BlendCertificate:
         }
 
 
-def certify_blends(world, waypoints: ArrayLike, share: float = BLEND_SHARE) -> BlendCertificate:
+def certify_blends(
+    world, waypoints: ArrayLike, share: float = BLEND_SHARE, backend: str = "kernel"
+) -> BlendCertificate:
     """The largest blend at each corner of a certified path that one guard proves free
     (module docstring).
 
@@ -113,6 +116,10 @@ def certify_blends(world, waypoints: ArrayLike, share: float = BLEND_SHARE) -> B
         The path's joint vectors, within the limits; consecutive ones differ.
     share : float
         :data:`BLEND_SHARE`.
+    backend : {"kernel", "python"}
+        Who advances along a blend: the compiled certifier (``ArmCertifier.check_blend``,
+        its guards' clearances capped at what each radius needs) or this module (every
+        clearance measured; the twin). Both prove the same way; their guards may differ.
 
     Returns
     -------
@@ -133,7 +140,10 @@ def certify_blends(world, waypoints: ArrayLike, share: float = BLEND_SHARE) -> B
     rho, C = point_speeds(arm), carries(arm)
     rho_pairs = relative_speeds(rho, C, pairs)
     only_first, only_second = C[pairs[:, 0]] & ~C[pairs[:, 1]], C[pairs[:, 1]] & ~C[pairs[:, 0]]
+    if backend not in ("kernel", "python"):
+        raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
     kernel = world.kernel
+    compiled = ArmCertifier(kernel, first_order=False) if backend == "kernel" else None
     dof = arm.dof
     first, second = pairs[:, 0], pairs[:, 1]
     queries = 0
@@ -164,6 +174,11 @@ def certify_blends(world, waypoints: ArrayLike, share: float = BLEND_SHARE) -> B
         while delta > radii[i]:  # larger blends, certified along their curve
             b, growth = 2.0 * delta * m, (2.0 * delta) ** 2 * growth_m
             a_, b_ = c - delta * u1[i], c + delta * u2[i]
+            if compiled is not None:
+                if compiled.check_blend(a_.tolist(), c.tolist(), b_.tolist(), BLEND_GUARDS):
+                    break
+                delta *= BLEND_SHRINK
+                continue
 
             def reach(t: float, s0: float, s1: float, a_=a_, b_=b_, c=c, b=b, growth=growth):
                 point = (1 - t) ** 2 * a_ + 2 * t * (1 - t) * c + t * t * b_
@@ -175,6 +190,8 @@ def certify_blends(world, waypoints: ArrayLike, share: float = BLEND_SHARE) -> B
                 break
             delta *= BLEND_SHRINK
         blends[i] = min(max(delta, radii[i]), caps[i])
+    if compiled is not None:
+        queries += int(compiled.counters["guards"])
     return BlendCertificate(blends, radii, caps, clearances, queries)
 
 
