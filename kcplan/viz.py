@@ -556,12 +556,13 @@ def plot_arm(
 
 
 def plot_joint_velocities(trajectory, path: str | os.PathLike, rate: float = 1000.0) -> None:
-    """Plot a timed trajectory's joint velocities and accelerations against their limits
-    (one panel each, every joint, the limits dashed), sampled at ``rate`` per second.
+    """Plot a timed trajectory's velocities and accelerations against their limits (one
+    panel each, the limits dashed), sampled at ``rate`` per second: an arm's joints, or a
+    rigid robot's translational and angular speed and acceleration (their sizes).
 
     Parameters
     ----------
-    trajectory : kcplan.planning.trajectory.CertifiedTrajectory
+    trajectory : kcplan.planning.trajectory.CertifiedTrajectory or RigidTimedPath
     path : path-like
         The ``.png`` file, written atomically.
     rate : float
@@ -569,13 +570,22 @@ def plot_joint_velocities(trajectory, path: str | os.PathLike, rate: float = 100
     """
     timed = trajectory.timed
     t, _, _, qd, qdd = timed.sample(rate)
+    if getattr(timed, "dimension", None) is not None:  # rigid: sizes of linear and angular
+        n = timed.dimension
+        qd = np.column_stack([np.linalg.norm(qd[:, :n], axis=1), np.linalg.norm(qd[:, n:], axis=1)])
+        qdd = np.column_stack(
+            [np.linalg.norm(qdd[:, :n], axis=1), np.linalg.norm(qdd[:, n:], axis=1)]
+        )
+        names, units = ("translational", "angular"), ("speed", "acceleration")
+    else:
+        names, units = trajectory.joints, ("velocity (rad/s)", "acceleration (rad/s²)")
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     colours = plt.get_cmap("tab10")
     for ax, values, limits, unit in (
-        (axes[0], qd, timed.velocity_limits, "velocity (rad/s)"),
-        (axes[1], qdd, timed.acceleration_limits, "acceleration (rad/s²)"),
+        (axes[0], qd, timed.velocity_limits, units[0]),
+        (axes[1], qdd, timed.acceleration_limits, units[1]),
     ):
-        for j, name in enumerate(trajectory.joints):
+        for j, name in enumerate(names):
             colour = colours(j % 10)
             ax.plot(t, values[:, j], color=colour, lw=1.0, label=name)
             ax.axhline(limits[j], color=colour, lw=0.6, ls="--")

@@ -206,7 +206,7 @@ def test_cli_writes_verifies_and_refuses_trajectories(tmp_path, monkeypatch, cap
     doc["qd"][len(doc["qd"]) // 2][0] = 100.0  # faster than any joint may go
     (tmp_path / "fast.json").write_text(json.dumps(doc))
     r = _kcplan("verify", BOX, "fast.json", cwd=tmp_path)
-    assert r.returncode == 1 and "a joint speed reaches" in r.stdout
+    assert r.returncode == 1 and "a speed reaches 41.797" in r.stdout
     del doc["qdd"]
     (tmp_path / "bad.json").write_text(json.dumps(doc))
     r = _kcplan("verify", BOX, "bad.json", cwd=tmp_path)
@@ -223,6 +223,50 @@ def test_cli_writes_verifies_and_refuses_trajectories(tmp_path, monkeypatch, cap
     assert not (tmp_path / "X.json").exists()
     r = _kcplan("plan", BOX, "--planner", "rrtconnect", "--trajectory", "X.json", cwd=tmp_path)
     assert r.returncode == 2 and "expected a kc-* or ca-* planner" in r.stderr
-    rigid = ROOT / "scenarios" / "2d" / "narrow_corridor.yaml"
-    r = _kcplan("plan", rigid, "--trajectory", "X.json", cwd=tmp_path)
-    assert r.returncode == 2 and "--trajectory: only for arms" in r.stderr
+    r = _kcplan("plan", BOX, "--trajectory", "X.json", "--speed-limit", "1,1", cwd=tmp_path)
+    assert r.returncode == 2 and "--speed-limit: a rigid robot's" in r.stderr
+
+
+def test_rigid_edges_take_the_exact_rest_to_rest_times_within_both_limits():
+    from kcplan.trajectory.rigid import time_rigid_path
+
+    W = np.array([[0.0, 0.0, 0.0], [3.0, 4.0, 0.5], [3.0, 4.0, 3.0], [3.0, 4.2, -2.9]])
+    v, a = np.array([2.0, 0.5]), np.array([1.0, 0.25])
+    timed = time_rigid_path(W, 2, v, a)
+    exact = 0.0  # the yaw goes the shorter way round: 3.0 -> -2.9 turns 0.383 rad
+    for length, angle in ((5.0, 0.5), (0.0, 2.5), (0.2, 2 * np.pi - 5.9)):
+        with np.errstate(divide="ignore"):
+            V = min(v[0] / length, v[1] / angle)  # per unit of the fraction f
+            A = min(a[0] / length, a[1] / angle)
+        exact += _trapezoid(1.0, V, A)
+    assert exact * (1 - 1e-9) <= timed.duration <= exact * 1.005
+    t, s, q, vel, acc = timed.sample(1000.0)
+    assert np.allclose(q[0], W[0]) and np.allclose(q[-1], W[-1]) and s[-1] == pytest.approx(3)
+    assert (np.linalg.norm(vel[:, :2], axis=1) <= v[0] * (1 + 1e-9)).all()
+    assert (np.abs(vel[:, 2]) <= v[1] * (1 + 1e-9)).all()
+    assert (np.abs(acc[:, 2]) <= a[1] * (1 + 1e-9)).all()
+    mid = (q[2:, :2] - q[:-2, :2]) / (t[2:] - t[:-2])[:, None]  # velocity is q's derivative
+    assert np.abs(mid - vel[1:-1, :2]).max() < 2e-3
+    assert max(timed.peak_ratios()) <= 1 + 1e-9
+
+
+def test_cli_times_and_verifies_a_rigid_robots_path(tmp_path, monkeypatch, capsys):
+    from kcplan.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    rigid = ROOT / "scenarios" / "3d" / "box_field.yaml"
+    assert main(["plan", str(rigid), "--seed", "1", "--trajectory", "R.json", "--speed-limit",
+                 "2,0.5"]) == 0  # fmt: skip
+    assert "stopping at every corner (rigid robot: no blends)" in capsys.readouterr().out
+    doc = json.loads((tmp_path / "R.json").read_text())
+    assert doc["joints"] == ["x", "y", "z", "qx", "qy", "qz", "qw"]
+    assert doc["velocity_limits"] == [2, 0.5]
+    assert main(["verify", str(rigid), "R.json"]) == 0
+    assert capsys.readouterr().out.startswith("clean: ")
+    doc["q"][len(doc["q"]) // 2][0] += 0.01  # a sample off the path
+    (tmp_path / "off.json").write_text(json.dumps(doc))
+    assert main(["verify", str(rigid), "off.json"]) == 1
+    assert "a sample is 0.01 off the curve" in capsys.readouterr().out
+    assert main(["plan", str(rigid), "--trajectory", "X.json", "--speed-limit", "1,0"]) == 2
+    assert "--speed-limit: velocity_limits: expected a translational and an angular" in (
+        capsys.readouterr().err)  # fmt: skip

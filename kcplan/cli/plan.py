@@ -136,28 +136,35 @@ def _trajectory_limits(args: argparse.Namespace, scenario, arm: bool):
     planning (None without it)."""
     wants = args.trajectory or args.velocity_plot
     if not wants:
-        if args.acceleration_limit is not None:
-            raise InputError(f"{args.scenario}: --acceleration-limit: only with --trajectory")
+        for flag in ("acceleration_limit", "speed_limit"):
+            if getattr(args, flag) is not None:
+                name = "--" + flag.replace("_", "-")
+                raise InputError(f"{args.scenario}: {name}: only with --trajectory")
         return None
-    if not arm:
-        raise InputError(f"{args.scenario}: --trajectory: only for arms (a URDF robot); a "
-                         "rigid robot's path is not timed yet")  # fmt: skip
     if not args.planner.startswith(("kc-", "ca-")):
         raise InputError(f"{args.scenario}: --trajectory: expected a kc-* or ca-* planner, "
                          f"whose edges are certified, got {args.planner}")  # fmt: skip
-    from kcplan.planning.trajectory import joint_limits
+    if arm and args.speed_limit is not None:
+        raise InputError(f"{args.scenario}: --speed-limit: a rigid robot's; an arm's joint "
+                         "velocity limits are its URDF's")  # fmt: skip
+    from kcplan.planning.trajectory import joint_limits, rigid_limits
 
-    given = None
-    if args.acceleration_limit is not None:
-        try:
-            given = [float(x) for x in args.acceleration_limit.split(",")]
-        except ValueError:
-            given = [math.nan]
-        given = given[0] if len(given) == 1 else given
+    given = {}
+    for flag in ("speed_limit", "acceleration_limit"):
+        value = getattr(args, flag)
+        if value is not None:
+            try:
+                numbers = [float(x) for x in value.split(",")]
+            except ValueError:
+                numbers = [math.nan]
+            given[flag] = numbers[0] if len(numbers) == 1 and arm else numbers
     try:
-        return joint_limits(scenario.arm, None, given)
+        if arm:
+            return joint_limits(scenario.arm, None, given.get("acceleration_limit"))
+        return rigid_limits(given.get("speed_limit"), given.get("acceleration_limit"))
     except ValueError as err:
-        flag = "--acceleration-limit" if "acceleration" in str(err) else "robot.urdf"
+        flag = ("--acceleration-limit" if "acceleration" in str(err) else
+                "--speed-limit" if not arm else "robot.urdf")  # fmt: skip
         raise InputError(f"{args.scenario}: {flag}: {err}") from None
 
 
@@ -167,10 +174,12 @@ def _write_trajectory(args: argparse.Namespace, timed) -> None:
 
     t = timed.timed
     rv, ra = t.peak_ratios()
+    certificate = getattr(timed, "certificate", None)
+    how = (f"{certificate.summary()['blends']} certified blends" if certificate is not None
+           else "stopping at every corner (rigid robot: no blends)")  # fmt: skip
     print(f"trajectory      : {t.duration:.3f} s ({timed.stop_duration:.3f} s stopping at "
-          f"every corner), {timed.certificate.summary()['blends']} certified blends, peak "
-          f"{rv:.3f} of the velocity and {ra:.3f} of the acceleration limits, smoothed and "
-          f"timed in {timed.seconds:.3f} s")  # fmt: skip
+          f"every corner), {how}, peak {rv:.3f} of the velocity and {ra:.3f} of the "
+          f"acceleration limits, ready in {timed.seconds:.3f} s")  # fmt: skip
     if args.trajectory:
         if args.trajectory.lower().endswith(".csv"):
             write_text_atomic(args.trajectory, timed.csv(args.rate))
@@ -181,7 +190,7 @@ def _write_trajectory(args: argparse.Namespace, timed) -> None:
         from kcplan.viz import plot_joint_velocities
 
         plot_joint_velocities(timed, args.velocity_plot)
-        print(f"joint velocities plotted in {args.velocity_plot}")
+        print(f"velocities plotted in {args.velocity_plot}")
 
 
 def path_guards(scenario, states) -> list:
@@ -241,9 +250,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--trajectory",
         metavar="TRAJ.json",
-        help="arms, kc-*/ca-* planners: smooth the path with certified blends, time it "
-        "within the joint limits (TOPP-RA) and write it sampled (.json, or .csv); "
-        "--animate and --html then play it in real time",
+        help="kc-*/ca-* planners: an arm's path smoothed with certified blends and timed "
+        "within its joint limits (TOPP-RA), a rigid robot's timed edge by edge within "
+        "--speed-limit and --acceleration-limit; written sampled (.json, or .csv); "
+        "--animate and --html then play an arm's in real time",
     )
     p.add_argument(
         "--rate",
@@ -255,8 +265,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--acceleration-limit",
         metavar="A[,A...]",
-        help="joint acceleration limits of --trajectory, rad/s^2: one for every joint or one "
-        "per joint (default: twice each joint's URDF velocity limit per second)",
+        help="acceleration limits of --trajectory: an arm's, rad/s^2, one for every joint or "
+        "one per joint (default: twice each joint's URDF velocity limit per second); a "
+        "rigid robot's, translational and angular (default 2,2)",
+    )
+    p.add_argument(
+        "--speed-limit",
+        metavar="V[,W]",
+        help="a rigid robot's translational (length unit/s) and angular (rad/s) speed "
+        "limits for --trajectory (default 1,1)",
     )
     p.add_argument(
         "--velocity-plot",

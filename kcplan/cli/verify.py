@@ -126,8 +126,7 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
     check_pieces`), every sample on that curve and within the limits it states."""
     arm = getattr(scenario, "arm", None)
     if arm is None:
-        raise InputError(f"{args.path}: curve: a trajectory file is an arm's; "
-                         f"{args.scenario} has a rigid robot")  # fmt: skip
+        return _verify_rigid_trajectory(args, scenario, data)
     if args.mesh is not None:
         raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
     from kcplan.arm.verify import ArmMeshChecker
@@ -145,15 +144,7 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
         raise InputError(f"{args.path}: curve.waypoints[{outside[0]}]: expected joint values "
                          "within the limits")  # fmt: skip
     off = file.deviations()
-    problems = []
-    if off["curve"] > CURVE_TOLERANCE:
-        problems.append(f"a sample is {off['curve']:.3g} rad off the curve")
-    if off["velocity"] > 1 + LIMIT_TOLERANCE:
-        problems.append(f"a joint speed reaches {off['velocity']:.6f} of its limit")
-    if off["acceleration"] > 1 + LIMIT_TOLERANCE:
-        problems.append(f"a joint acceleration reaches {off['acceleration']:.6f} of its limit")
-    if off["time"] <= 0 or off["parameter"] < 0:
-        problems.append("the samples do not move forward in time and along the curve")
+    problems = _sample_problems(off)
     checker = ArmMeshChecker(arm, scenario.obstacles, scenario.allowed, args.tolerance)
     check = checker.check_pieces(file.path.pieces())
     pieces = len(file.path.breakpoints) - 1
@@ -169,6 +160,56 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
           f"clearance {check.min_clearance:.6g}, {check.queries} distance queries; "
           f"{len(file.t)} samples on the curve (within {off['curve']:.1g} rad), peaks "
           f"{off['velocity']:.6f} of the velocity and {off['acceleration']:.6f} of the "
+          "acceleration limits")  # fmt: skip
+    return 0
+
+
+def _sample_problems(off: dict) -> list[str]:
+    """What is wrong with a trajectory's samples (:meth:`TrajectoryFile.deviations`)."""
+    problems = []
+    if off["curve"] > CURVE_TOLERANCE:
+        problems.append(f"a sample is {off['curve']:.3g} off the curve")
+    if off["velocity"] > 1 + LIMIT_TOLERANCE:
+        problems.append(f"a speed reaches {off['velocity']:.6f} of its limit")
+    if off["acceleration"] > 1 + LIMIT_TOLERANCE:
+        problems.append(f"an acceleration reaches {off['acceleration']:.6f} of its limit")
+    if off["time"] <= 0 or off["parameter"] < 0:
+        problems.append("the samples do not move forward in time and along the curve")
+    return problems
+
+
+def _verify_rigid_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
+    """A rigid robot's trajectory file: its path gap-free (as a path file's), every sample
+    on it and within its translational and angular limits."""
+    from kcplan.planning.trajectory import POSE_NAMES, read_rigid_trajectory
+    from kcplan.planning.verify import verify_path
+    from kcplan.world import CollisionWorld
+
+    n = scenario.dimension
+    if data.get("joints") != list(POSE_NAMES[n]):
+        raise InputError(f"{args.path}: joints: expected the pose of a {n}D rigid robot "
+                         f"{list(POSE_NAMES[n])}, got {data.get('joints')!r}")  # fmt: skip
+    try:
+        file = read_rigid_trajectory(data, n)
+    except ValueError as err:
+        raise InputError(f"{args.path}: {err}") from None
+    world = CollisionWorld(scenario)
+    part = ""
+    if args.mesh is not None:
+        world, part = _part_world(args, scenario, world)
+    off = file.deviations()
+    problems = _sample_problems(off)
+    check = verify_path(world, file.waypoints, tolerance=args.tolerance)
+    if check.collides:
+        problems.append(f"COLLISION{f' of {part}' if part else ''} on edge {check.edge_index} "
+                        f"at s = {check.s:.6f}")  # fmt: skip
+    if problems:
+        print("; ".join(problems) + f" ({check.queries} clearance queries)")
+        return 1
+    print(f"clean: {f'{part}, ' if part else ''}{len(file.waypoints) - 1} edges checked without "
+          f"gaps, minimum clearance {check.min_clearance:.6g}, {check.queries} clearance "
+          f"queries; {len(file.t)} samples on the path (within {off['curve']:.1g}), peaks "
+          f"{off['velocity']:.6f} of the speed and {off['acceleration']:.6f} of the "
           "acceleration limits")  # fmt: skip
     return 0
 

@@ -305,9 +305,10 @@ class PlanResult:
     """An arm's planning group: ``states`` are joint vectors in this order (else None:
     flat poses)."""
     trajectory: object = field(default=None, repr=False, compare=False)
-    """An arm's :class:`kcplan.planning.trajectory.CertifiedTrajectory` along the path,
-    when :func:`plan` was asked for it (``trajectory=True``); not written to JSON (its own
-    file: :meth:`~kcplan.planning.trajectory.CertifiedTrajectory.document`)."""
+    """The timed trajectory along the path when :func:`plan` was asked for it
+    (``trajectory=True``): an arm's :class:`kcplan.planning.trajectory.CertifiedTrajectory`,
+    a rigid robot's :class:`~kcplan.planning.trajectory.RigidTimedPath`; not written to
+    JSON (its own file: their ``document()``)."""
 
     def verify(self, tolerance: float = 1e-6) -> PathCheck:
         """Check the path without gaps, independently of every certificate
@@ -389,12 +390,14 @@ def plan(
         :func:`kcplan.planning.progress.reports_progress` holds: RRT*, Informed RRT*,
         SORRT*, AORRTC, BIT*; ignored for the others).
     trajectory : bool
-        An arm only, with a ``kc-*`` or ``ca-*`` planner (whose edges are certified):
-        smooth the path with certified blends and time it within the joint limits
-        (:func:`kcplan.planning.trajectory.certified_trajectory`), as
-        ``PlanResult.trajectory``.
+        With a ``kc-*`` or ``ca-*`` planner (whose edges are certified), as
+        ``PlanResult.trajectory``: an arm's path smoothed with certified blends and timed
+        within the joint limits (:func:`kcplan.planning.trajectory.certified_trajectory`);
+        a rigid robot's timed edge by edge within translational and angular limits,
+        stopping at every corner (:func:`kcplan.planning.trajectory.timed_rigid_path`).
     velocity_limits, acceleration_limits : optional
-        The trajectory's limits (:func:`kcplan.planning.trajectory.joint_limits`).
+        The trajectory's limits (:func:`kcplan.planning.trajectory.joint_limits`, or
+        :func:`~kcplan.planning.trajectory.rigid_limits`).
 
     Returns
     -------
@@ -408,9 +411,6 @@ def plan(
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     scenario = as_scenario(scenario)
-    if trajectory and not isinstance(scenario, ArmScenario):
-        raise ValueError("trajectory: only for arms (a URDF robot); a rigid robot's path "
-                         "is not timed yet")  # fmt: skip
     try:  # the arm-only planners refuse a rigid robot
         check_planner_name(planner, arm=isinstance(scenario, ArmScenario))
     except ValueError as err:
@@ -500,10 +500,16 @@ def plan(
             counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
-            from kcplan.planning.trajectory import certified_trajectory
+            from kcplan.planning import trajectory as trajectories
 
-            timed = certified_trajectory(setup.world, states, velocity_limits,
-                                         acceleration_limits)  # fmt: skip
+            if setup.joints is not None:
+                timed = trajectories.certified_trajectory(
+                    setup.world, states, velocity_limits, acceleration_limits
+                )
+            else:
+                timed = trajectories.timed_rigid_path(
+                    states, scenario.dimension, velocity_limits, acceleration_limits
+                )
     finally:
         if validator is not None:
             validator.close()

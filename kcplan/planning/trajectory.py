@@ -1,6 +1,8 @@
-"""An arm's certified, timed trajectory: its path smoothed by blends proved free
+"""Certified, timed trajectories. An arm's: its path smoothed by blends proved free
 (:mod:`kcplan.planning.smoothing`), then timed by TOPP-RA within the joints' velocity and
-acceleration limits (:mod:`kcplan.trajectory.timing`).
+acceleration limits (:mod:`kcplan.trajectory.timing`). A rigid robot's: its certified
+edges timed one by one within translational and angular limits, stopping at every
+corner (:mod:`kcplan.trajectory.rigid`; no blends).
 
 The trajectory follows the certified curve exactly (timing only chooses the speed along
 it), so every configuration it passes through is proved free: the straight pieces by the
@@ -22,14 +24,23 @@ from numpy.typing import ArrayLike, NDArray
 
 from kcplan.planning.smoothing import BlendCertificate, smooth_path
 from kcplan.trajectory.curve import BlendedPath
+from kcplan.trajectory.rigid import (
+    DEFAULT_RIGID_ACCELERATIONS,
+    DEFAULT_RIGID_SPEEDS,
+    RigidTrajectory,
+    time_rigid_path,
+)
 from kcplan.trajectory.timing import Trajectory, time_path
 
 __all__ = [
     "DEFAULT_ACCELERATION",
     "DEFAULT_RATE",
     "CertifiedTrajectory",
+    "RigidTimedPath",
     "certified_trajectory",
     "joint_limits",
+    "rigid_limits",
+    "timed_rigid_path",
 ]
 
 DEFAULT_ACCELERATION = 2.0
@@ -277,3 +288,195 @@ def read_trajectory(data: dict, dof: int) -> TrajectoryFile:
         array("velocity_limits", (dof,)),
         array("acceleration_limits", (dof,)),
     )
+
+
+POSE_NAMES = {2: ("x", "y", "yaw"), 3: ("x", "y", "z", "qx", "qy", "qz", "qw")}
+VELOCITY_NAMES = {2: ("vx", "vy", "wz"), 3: ("vx", "vy", "vz", "wx", "wy", "wz")}
+
+
+def rigid_limits(
+    velocity_limits: ArrayLike | None = None, acceleration_limits: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A rigid robot's translational and angular limits, checked: one number for both or
+    two (default :data:`~kcplan.trajectory.rigid.DEFAULT_RIGID_SPEEDS` and
+    :data:`~kcplan.trajectory.rigid.DEFAULT_RIGID_ACCELERATIONS`)."""
+    out = []
+    for name, given, default in (("velocity_limits", velocity_limits, DEFAULT_RIGID_SPEEDS),
+                                 ("acceleration_limits", acceleration_limits,
+                                  DEFAULT_RIGID_ACCELERATIONS)):  # fmt: skip
+        lim = np.array(default if given is None else given, dtype=float).reshape(-1)
+        lim = np.repeat(lim, 2) if lim.shape == (1,) else lim
+        if lim.shape != (2,) or not (np.isfinite(lim).all() and (lim > 0).all()):
+            raise ValueError(f"{name}: expected a translational and an angular limit > 0 "
+                             f"(or one for both), got {lim.tolist()}")  # fmt: skip
+        out.append(lim)
+    return out[0], out[1]
+
+
+@dataclass(frozen=True, eq=False)
+class RigidTimedPath:
+    """A rigid robot's certified path timed edge by edge, stopping at every corner.
+
+    Attributes
+    ----------
+    timed : RigidTrajectory
+    seconds : float
+        Wall-clock seconds spent timing.
+    """
+
+    timed: RigidTrajectory
+    seconds: float
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """The pose's components (:mod:`kcplan.geometry.pose` layout)."""
+        return POSE_NAMES[self.timed.dimension]
+
+    @property
+    def stop_duration(self) -> float:
+        """The same as the duration: a rigid path stops at every corner."""
+        return self.timed.duration
+
+    def document(self, rate: float = DEFAULT_RATE) -> dict:
+        """The trajectory file of a rigid robot: ``joints`` (the pose's components), ``t``,
+        ``s`` (edge index plus the fraction along it), ``q`` (poses), ``qd`` and ``qdd``
+        (``velocity_components``: the linear velocity of the robot's frame and its angular
+        velocity, world frame), ``velocity_limits`` and ``acceleration_limits``
+        (``limit_names``: translational, angular), ``duration``, ``peak_ratios``, ``curve``
+        (the waypoints; no blends) and ``certificate``."""
+        t, s, q, qd, qdd = self.timed.sample(rate)
+        rv, ra = self.timed.peak_ratios()
+        W = self.timed.waypoints
+        return {
+            "joints": list(self.joints),
+            "velocity_components": list(VELOCITY_NAMES[self.timed.dimension]),
+            "limit_names": ["translational", "angular"],
+            "rate": float(rate),
+            "duration": self.timed.duration,
+            "stop_at_corners_duration": self.timed.duration,
+            "velocity_limits": self.timed.velocity_limits.tolist(),
+            "acceleration_limits": self.timed.acceleration_limits.tolist(),
+            "peak_ratios": {"velocity": rv, "acceleration": ra},
+            "certificate": {
+                "edges": len(W) - 1,
+                "edge_certificate": "the planner's motion validator (kcplan.planning)",
+                "blends": 0,
+                "seconds": self.seconds,
+            },
+            "curve": {"waypoints": W.tolist(), "blends": []},
+            "t": t.tolist(),
+            "s": s.tolist(),
+            "q": q.tolist(),
+            "qd": qd.tolist(),
+            "qdd": qdd.tolist(),
+        }
+
+    def csv(self, rate: float = DEFAULT_RATE) -> str:
+        """The samples as CSV: ``t``, the pose, its velocity and acceleration."""
+        t, _, q, qd, qdd = self.timed.sample(rate)
+        names = VELOCITY_NAMES[self.timed.dimension]
+        header = ["t", *self.joints, *names, *(f"d{name}" for name in names)]
+        rows = np.column_stack([t, q, qd, qdd])
+        lines = [",".join(header)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
+        return "\n".join(lines) + "\n"
+
+
+def timed_rigid_path(
+    waypoints: Sequence[ArrayLike],
+    dimension: int,
+    velocity_limits: ArrayLike | None = None,
+    acceleration_limits: ArrayLike | None = None,
+) -> RigidTimedPath:
+    """A rigid robot's certified path timed edge by edge (:func:`rigid_limits`)."""
+    start = time.perf_counter()
+    v, a = rigid_limits(velocity_limits, acceleration_limits)
+    timed = time_rigid_path(waypoints, dimension, v, a)
+    return RigidTimedPath(timed, time.perf_counter() - start)
+
+
+@dataclass(frozen=True)
+class RigidTrajectoryFile:
+    """A rigid robot's trajectory file read back (:func:`read_rigid_trajectory`)."""
+
+    dimension: int
+    waypoints: NDArray[np.float64]
+    t: NDArray[np.float64]
+    s: NDArray[np.float64]
+    q: NDArray[np.float64]
+    qd: NDArray[np.float64]
+    qdd: NDArray[np.float64]
+    velocity_limits: NDArray[np.float64]
+    acceleration_limits: NDArray[np.float64]
+
+    def deviations(self) -> dict[str, float]:
+        """As :meth:`TrajectoryFile.deviations`: ``curve`` is the largest distance of a
+        sample's pose from the path's pose at its ``s`` (translation, plus the yaw
+        difference in 2D or the chord between the unit quaternions in 3D), ``velocity``
+        and ``acceleration`` the largest size of the linear or angular part over its
+        limit."""
+        from kcplan.geometry.pose import Edge
+
+        n, W = self.dimension, self.waypoints
+        k = np.clip(np.floor(self.s).astype(int), 0, len(W) - 2)
+        off = 0.0
+        for i, (edge_index, q) in enumerate(zip(k, self.q, strict=True)):
+            pose = Edge(W[edge_index], W[edge_index + 1], n).pose(self.s[i] - edge_index)
+            d = float(np.linalg.norm(pose[:n] - q[:n]))
+            if n == 2:
+                d += abs(float(np.angle(np.exp(1j * (pose[2] - q[2])))))
+            else:  # the chord between the quaternions, either sign (robust near 0)
+                d += min(float(np.linalg.norm(pose[3:] - q[3:])),
+                         float(np.linalg.norm(pose[3:] + q[3:])))  # fmt: skip
+            off = max(off, d)
+
+        def ratio(x: NDArray, limits: NDArray) -> float:
+            parts = (np.linalg.norm(x[:, :n], axis=1), np.linalg.norm(x[:, n:], axis=1))
+            pairs = zip(parts, limits, strict=True)
+            return float(max((p / lim).max(initial=0.0) for p, lim in pairs))
+
+        return {
+            "curve": off,
+            "velocity": ratio(self.qd, self.velocity_limits),
+            "acceleration": ratio(self.qdd, self.acceleration_limits),
+            "time": float(np.diff(self.t).min(initial=np.inf)),
+            "parameter": float(np.diff(self.s).min(initial=np.inf)),
+        }
+
+
+def read_rigid_trajectory(data: dict, dimension: int) -> RigidTrajectoryFile:
+    """A rigid robot's trajectory file (:meth:`RigidTimedPath.document`), checked.
+
+    Raises
+    ------
+    ValueError
+        ``FIELD: expected ...`` for the first field that is missing or malformed.
+    """
+    from kcplan.geometry.pose import pose_size
+
+    width, twist = pose_size(dimension), len(VELOCITY_NAMES[dimension])
+    curve = data.get("curve")
+    if not isinstance(curve, dict):
+        raise ValueError("curve: expected {waypoints, blends}: the certified path")
+    t = data.get("t")
+    if not isinstance(t, list) or len(t) < 2:
+        raise ValueError("t: expected a list of at least two sample times (s)")
+    m = len(t)
+    shapes = {"t": (m,), "s": (m,), "q": (m, width), "qd": (m, twist), "qdd": (m, twist),
+              "velocity_limits": (2,), "acceleration_limits": (2,)}  # fmt: skip
+    out = {}
+    for field, shape in (("curve.waypoints", None), *shapes.items()):
+        source = curve.get("waypoints") if field == "curve.waypoints" else data.get(field)
+        if source is None:
+            raise ValueError(f"{field}: expected the field (a trajectory file of kcplan plan "
+                             "--trajectory)")  # fmt: skip
+        try:
+            x = np.array(source, dtype=float)
+        except (TypeError, ValueError):
+            x = np.zeros(0)
+        ok = (x.ndim == 2 and x.shape[1] == width and len(x) >= 2) if shape is None else (
+            x.shape == shape)  # fmt: skip
+        if not ok or not np.isfinite(x).all():
+            want = f"poses of {width} numbers" if shape is None else f"shape {shape}"
+            raise ValueError(f"{field}: expected finite numbers, {want}")
+        out[field] = x
+    return RigidTrajectoryFile(dimension, out.pop("curve.waypoints"), **out)
