@@ -262,3 +262,39 @@ def test_a_state_a_hair_outside_a_limit_is_clamped_and_said_once(scenario_file, 
     path = scenario_file(goal={"joints": far})
     assert main(["plan", str(path)]) == 2
     assert f"got panda_joint4 {far[3]!r} > 0.0873" in capsys.readouterr().err
+
+
+TWIN_ARMS = """<robot name="twins">
+  <link name="base"/>
+  <link name="left"><collision><geometry><box size="0.2 0.05 0.3"/></geometry></collision></link>
+  <link name="right"><collision><geometry><box size="0.05 0.2 0.3"/></geometry></collision></link>
+  <joint name="j_left" type="revolute"><parent link="base"/><child link="left"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="j_right" type="revolute"><parent link="base"/><child link="right"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+"""Two links turning about one axis, each holding it: in contact at every configuration,
+and no SRDF to say so (as a gripper's two halves an SRDF forgot)."""
+
+
+def test_a_pair_in_contact_everywhere_is_named_with_the_line_that_allows_it(tmp_path, capsys):
+    urdf = tmp_path / "twins.urdf"
+    urdf.write_text(TWIN_ARMS)
+    assert main(["robot", "info", str(urdf)]) == 0
+    out = capsys.readouterr().out
+    assert ("in contact at every configuration tried (32 random ones within the limits): "
+            "[left, right]; a scenario must allow them: allowed: [[left, right]]"
+            ) in out  # fmt: skip
+    scenario = {"name": "twins", "robot": {"urdf": "twins.urdf", "joints": ["j_left", "j_right"]},
+                "start": {"joints": [0.0, 0.0]}, "goal": {"joints": [0.5, -0.5]},
+                "obstacles": []}  # fmt: skip
+    path = tmp_path / "twins.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    assert main(["plan", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"{path}: start: left and right touch at every configuration tried (32 "
+                   "random ones within the limits): the SRDF does not disable the pair; allow "
+                   "it in the scenario with allowed: [[left, right]]")  # fmt: skip
+    path.write_text(yaml.safe_dump(scenario | {"allowed": [["left", "right"]]}))
+    assert main(["plan", str(path), "--seed", "1"]) == 0

@@ -55,6 +55,8 @@ class ArmPathCheck:
     what : str
         What touches there: ``LINK and an obstacle`` or ``LINK and LINK`` (a held
         object counts as a link, by its name), or ``""``.
+    pair : tuple of str
+        The two links' names when two links touch there, else ``()``.
     queries : int
         Distance queries made (a link against the scene, or two links).
     """
@@ -64,6 +66,7 @@ class ArmPathCheck:
     where: tuple = ()
     queries: int = 0
     what: str = ""
+    pair: tuple = ()
 
 
 @functools.lru_cache(maxsize=256)
@@ -232,6 +235,24 @@ class ArmMeshChecker:
                 return near
         return _distance(self._links[a], self._links[b])
 
+    def contact_share(self, pair: tuple[str, str], samples: int = 32, seed: int = 0) -> float:
+        """The share of ``samples`` random configurations (uniform within the joint
+        limits, seeded) at which the links named ``pair`` touch on their own meshes: 1.0
+        for a pair in contact everywhere (two halves of a gripper whose SRDF forgot them),
+        which no planner can separate. 0.0 for a pair this checker does not check."""
+        names = set(pair)
+        items = [len(self._links) + m for m, (a, b) in enumerate(self._pairs)
+                 if {self._names[a], self._names[b]} == names]  # fmt: skip
+        if not items:
+            return 0.0
+        rng = np.random.default_rng(seed)
+        arm = self.arm
+        touching = 0
+        for _ in range(samples):
+            self._place(rng.uniform(arm.lower, arm.upper))
+            touching += any(self._distance(i) <= self.tolerance for i in items)
+        return touching / samples
+
     def _what(self, item: int) -> str:
         """The names of item ``item``'s two sides (:attr:`ArmPathCheck.what`)."""
         links = len(self._links)
@@ -239,6 +260,14 @@ class ArmMeshChecker:
             return f"{self._names[item]} and an obstacle"
         a, b = self._pairs[item - links]
         return f"{self._names[a]} and {self._names[b]}"
+
+    def _pair_names(self, item: int) -> tuple:
+        """The two links of item ``item`` when it is a self pair, else ``()``."""
+        links = len(self._links)
+        if item < links:
+            return ()
+        a, b = self._pairs[item - links]
+        return (self._names[a], self._names[b])
 
     def _scene_distance(self, obj: fcl.CollisionObject) -> float:
         result = fcl.DistanceData()
@@ -284,7 +313,8 @@ class ArmMeshChecker:
                     lowest = min(lowest, d)
                     if d <= self.tolerance:
                         return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries,
-                                            self._what(int(item)))  # fmt: skip
+                                            self._what(int(item)),
+                                            self._pair_names(int(item)))  # fmt: skip
                     # free on [s, s + d / v): this item's next sample is there
                     v = speeds[item]
                     step = d / v if v > 0 else math.inf

@@ -157,6 +157,15 @@ def run_info(args: argparse.Namespace) -> int:
           f"(both checked); proofs in {took:.2f} s")  # fmt: skip
     for p in proofs:
         print(f"  {p.links[0]} / {p.links[1]}: {p.verdict}")
+    from kcplan.arm.verify import ArmMeshChecker
+
+    checker = ArmMeshChecker(arm, [])
+    always = [p.links for p in proofs
+              if p.verdict == "touches" and checker.contact_share(p.links) == 1.0]  # fmt: skip
+    if always:  # no plan can separate them: the SRDF misses them
+        pairs = ", ".join(f"[{a}, {b}]" for a, b in always)
+        print(f"in contact at every configuration tried (32 random ones within the limits): "
+              f"{pairs}; a scenario must allow them: allowed: [{pairs}]")  # fmt: skip
     return 0
 
 

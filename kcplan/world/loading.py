@@ -23,7 +23,7 @@ def check_start_goal(scenario: Scenario) -> None:
     """Raise :class:`ScenarioError` naming the obstacles the robot touches at the start or
     the goal (``FILE: start: the robot collides with obstacles[3] (box)``)."""
     if not isinstance(scenario, Scenario):  # an arm
-        from kcplan.arm.verify import verify_arm_path
+        from kcplan.arm.verify import ArmMeshChecker
         from kcplan.arm.world import ArmWorld
 
         arm, obstacles = scenario.arm, scenario.obstacles
@@ -31,7 +31,15 @@ def check_start_goal(scenario: Scenario) -> None:
         for key, q in (("start", scenario.start), ("goal", scenario.goal)):
             if not arm_world.in_collision(q):
                 continue
-            meshes = verify_arm_path(arm, obstacles, [q, q], allowed=scenario.allowed)
+            checker = ArmMeshChecker(arm, obstacles, scenario.allowed)
+            meshes = checker.check([q, q])
+            if meshes.collides and meshes.pair and checker.contact_share(meshes.pair) == 1.0:
+                a, b = meshes.pair
+                raise ScenarioError(
+                    f"{scenario.source}: {key}: {a} and {b} touch at every configuration "
+                    f"tried (32 random ones within the limits): the SRDF does not disable "
+                    f"the pair; allow it in the scenario with allowed: [[{a}, {b}]]"
+                )
             if meshes.collides:
                 raise ScenarioError(
                     f"{scenario.source}: {key}: the arm's links touch an obstacle or each "
