@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from kcplan.arm.kinematics import link_frames
 from kcplan.arm.mbm import load_mbm_archive, mbm_scenario
 from kcplan.files import write_text_atomic
 from kcplan.planning.problem import plan
@@ -55,13 +56,8 @@ TURNS = (0.6, -0.6, 0.9, -0.9, 1.2, -1.2, 0.3, -0.3)
 
 
 def link_pose(arm, q, link: str) -> np.ndarray:
-    """The 4 x 4 world frame of URDF link ``link`` at joint vector ``q`` (Pinocchio)."""
-    import pinocchio as pin
-
-    model, data = arm.model, arm.model.createData()
-    pin.forwardKinematics(model, data, arm.configuration(q))
-    pin.updateFramePlacements(model, data)
-    return np.asarray(data.oMf[model.getFrameId(link)].homogeneous)
+    """The 4 x 4 world frame of URDF link ``link`` at joint vector ``q``."""
+    return link_frames(arm, [q], link)[0]
 
 
 def _pose(obstacle) -> np.ndarray:

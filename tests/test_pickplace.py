@@ -1,6 +1,7 @@
 """Pick-and-place error analysis: LWR kinematics, error spaces, inflation, parts entropy."""
 
 import csv
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -161,3 +162,49 @@ def test_pick_place_command(tmp_path, capsys):
     assert main(["pick-place", "--sigma-deg", "-1", "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--sigma-deg" in err
+
+
+PANDA_URDF = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "panda" / "panda.urdf"
+
+
+def test_a_urdf_arm_holds_the_object_at_its_link_through_pinocchio():
+    """link_frames (the reduced model's joint frames and the link's placement) against
+    Pinocchio's own frame placement, and the study with a URDF arm: no noise, no inflation;
+    noise needs some, more with more noise."""
+    import pinocchio as pin
+
+    from kcplan.arm import load_arm
+    from kcplan.arm.kinematics import link_frames
+
+    arm = load_arm(PANDA_URDF, [f"panda_joint{i}" for i in range(1, 8)])
+    rng = np.random.default_rng(4)
+    Q = rng.uniform(arm.lower, arm.upper, (5, arm.dof))
+    frames = link_frames(arm, Q, "panda_hand")
+    data = arm.model.createData()
+    for q, F in zip(Q, frames, strict=True):
+        pin.framesForwardKinematics(arm.model, data, arm.configuration(q))
+        expected = data.oMf[arm.model.getFrameId("panda_hand")].homogeneous
+        np.testing.assert_allclose(F, expected, atol=1e-12)
+    q = 0.5 * (arm.lower + arm.upper)
+    forward = lambda Q: link_frames(arm, Q, "panda_hand")  # noqa: E731
+    _, rows = noise_study([0.0, 0.1, 0.5], trials=2, poses=30, q=q, forward=forward)
+    eps = [r["eps_exact_median"] for r in rows]
+    assert eps[0] == 0.0 and 0.0 < eps[1] < eps[2]
+
+
+def test_pick_place_takes_a_urdf_arm_and_refuses_a_bad_one(tmp_path, capsys):
+    out = tmp_path / "pp"
+    args = ["pick-place", "--urdf", str(PANDA_URDF), "--link", "panda_hand", "--sigma-deg",
+            "0", "0.2", "--trials", "2", "--poses", "20", "-o", str(out)]  # fmt: skip
+    assert main(args) == 0
+    assert "arm: arm of 7 joints" in capsys.readouterr().out
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert float(rows[0]["eps_exact_median"]) == 0.0 < float(rows[1]["eps_exact_median"])
+    assert main(["pick-place", "--urdf", str(PANDA_URDF), "--link", "nope", "-o", str(out)]) == 2
+    assert capsys.readouterr().err.strip().endswith("--link: expected a link of "
+                                                    f"{PANDA_URDF}, got 'nope'")  # fmt: skip
+    assert main(["pick-place", "--urdf", str(PANDA_URDF), "--link", "panda_hand", "--q", "0",
+                 "-o", str(out)]) == 2  # fmt: skip
+    assert "--q: expected 7 joint values (panda_joint1" in capsys.readouterr().err
+    assert main(["pick-place", "--link", "panda_hand", "-o", str(out)]) == 2
+    assert capsys.readouterr().err.strip() == "kcplan pick-place: --link: only with --urdf"

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from kcplan.arm.model import JOINT_KINDS, ArmModel
 
-__all__ = ["body_frames", "joint_axes", "joint_frames"]
+__all__ = ["body_frames", "joint_axes", "joint_frames", "link_frames"]
 
 
 def joint_axes(arm: ArmModel) -> NDArray[np.float64]:
@@ -73,3 +73,23 @@ def body_frames(arm: ArmModel, state: Sequence[float]) -> NDArray[np.float64]:
     frame's origin along its axes."""
     frames = joint_frames(arm, state)
     return np.stack([frames[b.joint] @ b.placement for b in arm.bodies])
+
+
+def link_frames(arm: ArmModel, states: Sequence[Sequence[float]], link: str) -> NDArray[np.float64]:
+    """World frames of the URDF link ``link`` at each of ``states`` (``(k, dof)``), shape
+    ``(k, 4, 4)``: its parent joint's frame (:func:`joint_frames`) times the link's
+    placement in it.
+
+    Raises
+    ------
+    ValueError
+        ``link: expected a link of the URDF ...`` for a name that is not one.
+    """
+    model = arm.model
+    fid = model.getFrameId(link)
+    if fid >= len(model.frames) or model.frames[fid].name != link:
+        raise ValueError(f"link: expected a link of {arm.urdf}, got {link!r}")
+    frame = model.frames[fid]
+    placement = np.asarray(frame.placement.homogeneous, dtype=float)
+    joint = int(frame.parentJoint)
+    return np.stack([joint_frames(arm, q)[joint] @ placement for q in np.atleast_2d(states)])

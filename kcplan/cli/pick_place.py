@@ -46,9 +46,13 @@ def run(args: argparse.Namespace) -> int:
             flush=True,
         )
 
+    q, forward, arm_name = _arm(args)
+    print(f"arm: {arm_name}, held at {args.link or 'the flange'}, joints "
+          f"{', '.join(f'{v:.4g}' for v in q)} rad")  # fmt: skip
     trials, sigmas = noise_study(
-        args.sigma_deg, args.trials, args.poses, args.inflation, args.seed, progress=report
-    )
+        args.sigma_deg, args.trials, args.poses, args.inflation, args.seed, q=q,
+        progress=report, forward=forward,
+    )  # fmt: skip
     write_text_atomic(out / "trials.csv", _rows_csv(trials))
     write_text_atomic(out / "summary.csv", _rows_csv(sigmas))
     plot_noise_inflation_entropy(sigmas, args.inflation, out / "pick_place.png")
@@ -56,12 +60,61 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _arm(args: argparse.Namespace):
+    """``(joint angles, forward kinematics or None, what the arm is)``: the paper's KUKA
+    LWR, or ``--urdf``'s arm holding the object at ``--link`` (Pinocchio's model)."""
+    import numpy as np
+
+    from kcplan.pickplace.analysis import PAPER_JOINTS
+
+    if args.urdf is None:
+        for flag in ("link", "joints", "q"):
+            if getattr(args, flag):
+                raise InputError(f"kcplan pick-place: --{flag}: only with --urdf")
+        return PAPER_JOINTS, None, "KUKA LWR 4 (paper Table 2, DH)"
+    from kcplan.arm import ArmError, load_arm
+    from kcplan.arm.kinematics import link_frames
+
+    if not Path(args.urdf).is_file():
+        raise InputError(f"{args.urdf}: --urdf: expected an existing URDF file")
+    if not args.link:
+        raise InputError(f"{args.urdf}: --link: expected the link that holds the object")
+    joints = args.joints
+    if not joints:
+        import pinocchio as pin
+
+        from kcplan.arm.model import JOINT_KINDS
+
+        try:
+            full = pin.buildModelFromUrdf(args.urdf)
+        except (RuntimeError, ValueError, OSError) as err:
+            raise InputError(f"{args.urdf}: urdf: expected a readable URDF, got: {err}") from None
+        joints = [n for n in full.names[1:]
+                  if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]  # fmt: skip
+    try:
+        arm = load_arm(args.urdf, joints, package_dirs=args.package_dir)
+    except ArmError as err:
+        raise InputError(str(err)) from None
+    q = 0.5 * (arm.lower + arm.upper) if args.q is None else np.array(args.q, dtype=float)
+    if q.shape != (arm.dof,):
+        raise InputError(f"{args.urdf}: --q: expected {arm.dof} joint values "
+                         f"({', '.join(arm.joints)}), got {len(q)}")  # fmt: skip
+    if not arm.within_limits(q):
+        raise InputError(f"{args.urdf}: --q: expected joint values within the URDF's limits")
+    try:
+        link_frames(arm, q[None], args.link)
+    except ValueError as err:
+        raise InputError(f"{args.urdf}: --{err}") from None
+    return q, lambda Q: link_frames(arm, Q, args.link), f"{arm.describe()}"
+
+
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``kcplan pick-place`` on the subcommand parsers ``sub``."""
     p = sub.add_parser(
         "pick-place",
         help="pick-and-place error analysis: required target inflation and parts entropy",
-        description="The paper's Sec. 9.2 study with a KUKA LWR (Table 2 setting): for each "
+        description="The paper's Sec. 9.2 study with a KUKA LWR (Table 2 setting; or any "
+        "URDF arm: --urdf, --link): for each "
         "joint noise level, TRIALS error spaces of POSES placements; the smallest target "
         "inflation containing each (exact margin, geometric lower bound), whether the "
         "target inflated by --inflation contains it, and the parts entropy log V at the "
@@ -87,6 +140,29 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="the target's inflation for the containment question (default 0.05)",
     )
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--urdf",
+        metavar="URDF",
+        help="study this arm instead of the paper's KUKA LWR (Pinocchio's kinematics)",
+    )
+    p.add_argument("--link", help="with --urdf: the link that holds the object (its frame)")
+    p.add_argument(
+        "--joints",
+        nargs="+",
+        metavar="JOINT",
+        help="with --urdf: the joints (default: every movable one)",
+    )
+    p.add_argument(
+        "--q",
+        nargs="+",
+        type=finite_float,
+        metavar="Q",
+        help="with --urdf: the placing configuration, rad (default: the middle of the limits)",
+    )
+    p.add_argument(
+        "--package-dir", action="append", default=[], metavar="DIR",
+        help="with --urdf: a folder of package:// meshes (repeatable)",
+    )  # fmt: skip
     p.add_argument(
         "-o",
         "--output",

@@ -25,6 +25,7 @@ object in the target (rad^3 m^3, exponential coordinates of the identity compone
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -68,6 +69,7 @@ def error_space(
     q: ArrayLike = PAPER_JOINTS,
     rng: np.random.Generator | int | None = None,
     dh: ArrayLike = LWR_DH,
+    forward: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
 ) -> NDArray[np.float64]:
     """Relative poses of the placed object for noisy joints.
 
@@ -80,6 +82,11 @@ def error_space(
     q : array_like, shape (7,)
         Desired joint angles, radians.
     rng : numpy Generator or seed, optional
+    dh : array_like, shape (len(q), 3)
+        The arm's DH parameters (:func:`kcplan.pickplace.kinematics.forward_kinematics`).
+    forward : callable, optional
+        Joint vectors ``(k, len(q))`` to the held object's frames ``(k, 4, 4)``, in place
+        of ``dh`` (a URDF arm: :func:`kcplan.arm.kinematics.link_frames`).
 
     Returns
     -------
@@ -92,7 +99,9 @@ def error_space(
     gen = np.random.default_rng(rng)
     q = np.asarray(q, dtype=float)
     noisy = q + sigma * gen.standard_normal((int(poses), len(q)))
-    return relative_poses(forward_kinematics(q, dh), forward_kinematics(noisy, dh))
+    if forward is None:
+        return relative_poses(forward_kinematics(q, dh), forward_kinematics(noisy, dh))
+    return relative_poses(forward(q[None])[0], forward(noisy))
 
 
 def min_inflation(
@@ -176,6 +185,7 @@ def noise_study(
     semi_axes: ArrayLike = OBJECT_SEMI_AXES,
     q: ArrayLike = PAPER_JOINTS,
     progress=None,
+    forward: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
 ) -> tuple[list[dict], list[dict]]:
     """The study of ``kcplan pick-place``: per noise level, ``trials`` error spaces.
 
@@ -186,7 +196,8 @@ def noise_study(
     lower bound. A sigma row has the medians and 10/90 % quantiles of both inflations
     over the trials, the fractions of trials contained, and the parts entropy at the
     median exact inflation (true KC volume and geometric lower bound). Trial ``t`` of
-    every noise level draws from ``numpy.random.default_rng((seed, t))``.
+    every noise level draws from ``numpy.random.default_rng((seed, t))``. ``q`` and
+    ``forward``: the arm (:func:`error_space`; default the paper's KUKA LWR).
     """
     a = np.asarray(semi_axes, dtype=float)
     target = GeometricLowerBound(a, target_inflation)
@@ -195,7 +206,8 @@ def noise_study(
     for sigma in np.asarray(sigmas_deg, dtype=float):
         mine = []
         for t in range(trials):
-            xi = error_space(np.radians(sigma), poses, q, np.random.default_rng((seed, t)))
+            rng = np.random.default_rng((seed, t))
+            xi = error_space(np.radians(sigma), poses, q, rng, forward=forward)
             margin = containment_margin(a, a, xi)
             row = {
                 "sigma_deg": float(sigma),
