@@ -142,7 +142,7 @@ def markdown(rows: list[dict], timing: list[dict], samples: int) -> str:
 
 
 def plot(rows: list[dict], path: Path) -> None:
-    from kcplan.viz import plt, save_figure
+    from kcplan.views.plots import plt, save_figure
 
     meshes = list(dict.fromkeys(r["mesh"] for r in rows))
     fig, ax = plt.subplots(figsize=(8, 5))

@@ -607,7 +607,7 @@ def main() -> None:
             scen = load_scenario(path)  # validates, including start and goal collisions
             print(f"{path}: {len(scen.obstacles)} obstacles")
             if not args.no_pictures:
-                from kcplan.viz import plot_scenario
+                from kcplan.views.plots import plot_scenario
 
                 plot_scenario(scen, path.with_suffix(".png"), guards=scen.inflation)
 

@@ -149,8 +149,8 @@ def sequence(problem, name: str, args, folder: Path) -> dict:
 def write_view(run: dict, path: str, link: str, frames: int = 60) -> None:
     """The whole sequence of one problem as one HTML view: the held object is one more
     moving mesh, standing, carried by the hand, then left (module docstring)."""
-    from kcplan.arm_view import joint_path
-    from kcplan.html_view import arm_html, arm_view_data
+    from kcplan.views.arm import joint_path
+    from kcplan.views.html import arm_html, arm_view_data
 
     reach, carry, back = run["scenarios"]
     legs = [joint_path(run["legs"][leg]["states"], frames) for leg in ("reach", "carry", "return")]

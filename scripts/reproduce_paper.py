@@ -25,7 +25,7 @@ import numpy as np
 
 from kcplan.geometry import containment_margin, first_order_margin, ray_extent
 from kcplan.kc import ConvexLowerBound, GeometricLowerBound, kc_volume
-from kcplan.viz import save_figure
+from kcplan.views.plots import save_figure
 
 A2 = np.array([5.0, 3.5])
 A3 = np.array([4.0, 2.5, 2.0])

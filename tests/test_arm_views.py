@@ -1,5 +1,5 @@
-"""Views of arms (kcplan.arm_view, the arm parts of kcplan.html_view, kcplan.animation and
-kcplan.viz, and their options on the command line): the page holds the expected frames and
+"""Views of arms (kcplan.views.arm, the arm parts of kcplan.views.html, kcplan.views.animation and
+kcplan.views.plots, and their options on the command line): the page holds the expected frames and
 meshes posed as Pinocchio poses them, its script poses them the same way, the GIF has the
 expected frames, bad outputs are one line and exit 2 with no file left behind."""
 
@@ -15,8 +15,8 @@ import pytest
 import yaml
 
 from kcplan.arm.kinematics import body_frames
-from kcplan.arm_view import arm_meshes, cover_meshes, decimate, joint_path, mesh_frames
 from kcplan.cli import main
+from kcplan.views.arm import arm_meshes, cover_meshes, decimate, joint_path, mesh_frames
 from kcplan.world import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -97,7 +97,7 @@ def test_decimation_bounds_the_triangles_and_keeps_the_shape():
 
 
 def test_the_page_holds_every_frame_and_mesh_posed_as_pinocchio_poses_them(scenario, tmp_path):
-    from kcplan.html_view import write_scene_html
+    from kcplan.views.html import write_scene_html
 
     out = tmp_path / "arm.html"
     source = write_scene_html(scenario, out, PATH)
@@ -132,7 +132,7 @@ def test_the_page_holds_every_frame_and_mesh_posed_as_pinocchio_poses_them(scena
 def test_the_page_script_poses_the_meshes_like_python(scenario, tmp_path):
     """Run the page's own script in node (plotly stubbed) and compare what it hands to
     ``Plotly.restyle`` with the meshes posed in Python at the first frame."""
-    from kcplan.html_view import _ARM_SCRIPT, arm_view_data
+    from kcplan.views.html import _ARM_SCRIPT, arm_view_data
 
     data = arm_view_data(scenario, PATH, frames=5)
     data["traces"] = {"start": 0, "goal": 1, "arm": 2, "cover": 3}
@@ -186,7 +186,7 @@ def test_the_page_renders_the_arm_moving_in_a_headless_browser(scenario, tmp_pat
 
     from PIL import Image
 
-    from kcplan.html_view import write_scene_html
+    from kcplan.views.html import write_scene_html
 
     browser = shutil.which("chromium")
     if browser is None:
@@ -218,7 +218,7 @@ def test_the_page_renders_the_arm_moving_in_a_headless_browser(scenario, tmp_pat
 def test_the_gif_has_the_expected_frames_and_size(scenario, tmp_path):
     from PIL import Image
 
-    from kcplan.animation import animate_arm
+    from kcplan.views.animation import animate_arm
 
     out = tmp_path / "arm.gif"
     count = animate_arm(scenario, PATH, out, frames=6, dpi=30, max_faces=100)
@@ -228,8 +228,8 @@ def test_the_gif_has_the_expected_frames_and_size(scenario, tmp_path):
 
 
 def test_the_public_views_take_arms(scenario, reach, tmp_path):
-    from kcplan.html_view import scene_figure
-    from kcplan.viz import plot_path, plot_scenario
+    from kcplan.views.html import scene_figure
+    from kcplan.views.plots import plot_path, plot_scenario
 
     plot_path(scenario, PATH, tmp_path / "path.png")
     plot_scenario(reach, tmp_path / "scene.png")
@@ -243,7 +243,7 @@ def test_the_public_views_take_arms(scenario, reach, tmp_path):
 def test_a_failed_gif_leaves_no_file(scenario, tmp_path, monkeypatch):
     from matplotlib.animation import FuncAnimation
 
-    from kcplan.animation import animate_arm
+    from kcplan.views.animation import animate_arm
 
     def broken(self, filename, *args, **kwargs):
         Path(filename).write_bytes(b"GIF89a half")

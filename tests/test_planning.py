@@ -389,7 +389,7 @@ def test_public_entry_points_take_a_scenario_or_its_path():
     """``plan``, ``CollisionWorld`` and the views accept a path (str or os.PathLike) as
     well as a Scenario, and say what is expected for anything else."""
     import kcplan
-    from kcplan.html_view import scene_figure
+    from kcplan.views.html import scene_figure
 
     path = ROOT / "scenarios" / "2d" / "l_turn.yaml"
     for given in (str(path), path, load_scenario(path)):

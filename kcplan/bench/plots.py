@@ -10,7 +10,7 @@ import numpy as np
 from matplotlib import colors as mcolors
 
 from kcplan.bench.summary import cost_at, solution_time
-from kcplan.viz import plt, save_figure  # pyplot with the Agg backend kcplan.viz chose
+from kcplan.views.plots import plt, save_figure  # pyplot on the Agg backend views.plots chose
 
 __all__ = ["plot_distributions", "plot_success_vs_budget", "plot_cost_over_time"]
 

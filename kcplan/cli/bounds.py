@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"kcplan bounds: {err}") from None
     bound = report.pop("_bound")
     if args.plot:
-        from kcplan.viz import plot_convex_bound
+        from kcplan.views.plots import plot_convex_bound
 
         plot_convex_bound(bound, args.plot)
     if args.json:

@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
             flag = "--" + option.replace("_", "-")
             raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
     if arm and args.meshes == "visual" and (args.plot or args.animate or args.html):
-        from kcplan.arm_view import visual_meshes_missing
+        from kcplan.views.arm import visual_meshes_missing
 
         reason = visual_meshes_missing(scenario.arm)
         if reason:
@@ -79,14 +79,14 @@ def run(args: argparse.Namespace) -> int:
     if timed is not None:
         _write_trajectory(args, timed)
     if args.plot and arm:
-        from kcplan.viz import plot_arm
+        from kcplan.views.plots import plot_arm
 
         source = plot_arm(scenario, args.plot, result.states if result.solved else None,
                           title=f"{scenario.name}: {args.planner}, {status}",
                           show_cover=args.show_cover, meshes=args.meshes)  # fmt: skip
         print(f"plot written to {args.plot} (links: {source})")
     elif args.plot:
-        from kcplan.viz import plot_path
+        from kcplan.views.plots import plot_path
 
         guards = None
         if args.guards and result.solved:
@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
         )
         print(f"plot written to {args.plot}")
     if args.animate and result.solved and arm:
-        from kcplan.animation import animate_arm
+        from kcplan.views.animation import animate_arm
 
         states, fps = result.states, 10
         if timed is not None:  # in real time: one frame every 1 / fps seconds
@@ -111,14 +111,14 @@ def run(args: argparse.Namespace) -> int:
                              fps=fps, timed=timed is not None)  # fmt: skip
         print(f"animation written to {args.animate} ({frames} frames)")
     elif args.animate and result.solved:
-        from kcplan.animation import animate_path
+        from kcplan.views.animation import animate_path
 
         frames = animate_path(
             scenario, result.states, args.animate, title=f"{scenario.name}: {args.planner}"
         )
         print(f"animation written to {args.animate} ({frames} frames)")
     if args.html:
-        from kcplan.html_view import write_scene_html
+        from kcplan.views.html import write_scene_html
 
         states = result.states if result.solved else None
         frame_ms = None
@@ -187,7 +187,7 @@ def _write_trajectory(args: argparse.Namespace, timed) -> None:
             write_text_atomic(args.trajectory, json.dumps(timed.document(args.rate)) + "\n")
         print(f"trajectory written to {args.trajectory} ({args.rate:g} samples a second)")
     if args.velocity_plot:
-        from kcplan.viz import plot_joint_velocities
+        from kcplan.views.plots import plot_joint_velocities
 
         plot_joint_velocities(timed, args.velocity_plot)
         print(f"velocities plotted in {args.velocity_plot}")

@@ -94,12 +94,12 @@ def run_fit(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
     tightness = f"union / part {ratio:.3f}"
     if args.plot:
-        from kcplan.viz import plot_cover
+        from kcplan.views.plots import plot_cover
 
         plot_cover(cover, args.plot, tightness)
         print(f"picture written to {args.plot}", file=report)
     if args.html:
-        from kcplan.html_view import write_cover_html
+        from kcplan.views.html import write_cover_html
 
         write_cover_html(cover, args.html)
         print(f"interactive view written to {args.html}", file=report)

@@ -19,13 +19,13 @@ def run(args: argparse.Namespace) -> int:
             flag = "--" + option.replace("_", "-")
             raise InputError(f"{args.scenario}: {flag}: only for arms (a URDF robot)")
     if arm and args.meshes == "visual":
-        from kcplan.arm_view import visual_meshes_missing
+        from kcplan.views.arm import visual_meshes_missing
 
         reason = visual_meshes_missing(scenario.arm)
         if reason:
             raise InputError(f"{args.scenario}: --meshes visual: {reason}")
     if args.html:
-        from kcplan.html_view import write_scene_html
+        from kcplan.views.html import write_scene_html
 
         source = write_scene_html(scenario, args.html, None, args.show_cover, args.meshes)
         links = f" (links: {source})" if source else ""
@@ -34,12 +34,12 @@ def run(args: argparse.Namespace) -> int:
             return 0
     out = args.output or str(Path(args.scenario).with_suffix(".png"))
     if arm:
-        from kcplan.viz import plot_arm
+        from kcplan.views.plots import plot_arm
 
         source = plot_arm(scenario, out, show_cover=args.show_cover, meshes=args.meshes)
         print(f"picture written to {out} (links: {source})")
         return 0
-    from kcplan.viz import plot_scenario
+    from kcplan.views.plots import plot_scenario
 
     plot_scenario(scenario, out, guards=scenario.inflation)
     print(f"picture written to {out}")

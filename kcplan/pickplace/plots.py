@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from kcplan.viz import plt, save_figure
+from kcplan.views.plots import plt, save_figure
 
 __all__ = ["plot_noise_inflation_entropy"]
 

@@ -422,7 +422,7 @@ def arm_view_angles(scenario) -> tuple[float, float]:
 
 def _obstacle_layer(scenario) -> tuple[np.ndarray, np.ndarray]:
     """Every obstacle's triangles ``(m, 3, 3)`` and their RGBA, see-through grey."""
-    from kcplan.arm_view import obstacle_mesh
+    from kcplan.views.arm import obstacle_mesh
 
     corners = [V[F] for V, F in (obstacle_mesh(ob) for ob in scenario.obstacles)]
     if not corners:
@@ -434,7 +434,7 @@ def _obstacle_layer(scenario) -> tuple[np.ndarray, np.ndarray]:
 def _arm_layer(meshes, frames, rgb=None, alpha: float = 1.0):
     """The arm's triangles at one state's joint frames, coloured ``rgb`` (default: each
     mesh's own colours), with opacity ``alpha``."""
-    from kcplan.arm_view import posed_triangles
+    from kcplan.views.arm import posed_triangles
 
     corners, colors = posed_triangles(meshes, frames)
     if rgb is not None:
@@ -498,7 +498,7 @@ def plot_arm(
     show_cover : bool
         Also draw the covering ellipsoids at the start and the goal (see-through).
     meshes : {"auto", "visual", "collision"}
-        :func:`kcplan.arm_view.arm_meshes`.
+        :func:`kcplan.views.arm.arm_meshes`.
     max_faces : int
         Triangles per link mesh at most.
     dpi : int
@@ -509,7 +509,7 @@ def plot_arm(
     str
         Which meshes draw the links.
     """
-    from kcplan.arm_view import arm_meshes, joint_frames_along, joint_path, tip_joint
+    from kcplan.views.arm import arm_meshes, joint_frames_along, joint_path, tip_joint
 
     scenario = as_scenario(scenario)
     arm = scenario.arm
@@ -532,7 +532,7 @@ def plot_arm(
             k = int(np.argmin(np.abs(lengths - s)))
             layers.append(_arm_layer(links, along[k], _PATH_RGB, 0.25))
     if show_cover:  # see-through, in the same collection: ordered by depth with the links
-        from kcplan.arm_view import cover_meshes
+        from kcplan.views.arm import cover_meshes
 
         cover = cover_meshes(arm, 1)
         layers += [_arm_layer(cover, ends[0], _START_RGB, 0.2),

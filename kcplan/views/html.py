@@ -18,7 +18,7 @@ import plotly.graph_objects as go
 from kcplan.files import write_text_atomic
 from kcplan.geometry.pose import pose_frame
 from kcplan.maps.superquadric import unit_normals
-from kcplan.viz import body_shapes, ellipse_outline, path_poses
+from kcplan.views.plots import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
 from kcplan.world.scenario import Obstacle, Scenario, as_scenario
 from kcplan.world.support import box_vertices
@@ -47,7 +47,7 @@ def _obstacle_meshes(ob: Obstacle, n: int) -> list[tuple[np.ndarray, np.ndarray]
     if ob.kind in ("mesh", "convex"):
         return [(ob.vertices, ob.triangles)]
     if ob.kind == "cylinder":
-        from kcplan.arm_view import cylinder_mesh
+        from kcplan.views.arm import cylinder_mesh
 
         return [cylinder_mesh(ob)]
     if n == 2 and ob.kind in ("box", "polygon"):
@@ -365,7 +365,7 @@ def _hex(rgb) -> str:
 
 
 def _mesh_data(mesh) -> dict:
-    """One :class:`kcplan.arm_view.LinkMesh` for the page: vertices rounded to 1 µm, faces,
+    """One :class:`kcplan.views.arm.LinkMesh` for the page: vertices rounded to 1 µm, faces,
     and its colours as a palette with an index per face (none when it has one colour)."""
     palette, index = np.unique(np.round(mesh.colors, 3), axis=0, return_inverse=True)
     out = {
@@ -398,10 +398,10 @@ def arm_view_data(
     scenario : kcplan.arm.scenario.ArmScenario
     states : array_like, shape (k, dof), optional
         The path; interpolated in joint space into about ``frames`` frames
-        (:func:`kcplan.arm_view.joint_path`). Without it the frames are the start and the
+        (:func:`kcplan.views.arm.joint_path`). Without it the frames are the start and the
         goal.
     meshes : {"auto", "visual", "collision"}
-        Which of the URDF's meshes draw the links (:func:`kcplan.arm_view.arm_meshes`).
+        Which of the URDF's meshes draw the links (:func:`kcplan.views.arm.arm_meshes`).
     max_faces : int
         Triangles per link mesh at most.
     timed : bool
@@ -418,7 +418,7 @@ def arm_view_data(
         faces), ``source`` (which meshes) and ``path`` (the tip joint's origin per
         frame). Frames are rounded to 12 decimals, vertices to 1 µm.
     """
-    from kcplan.arm_view import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
+    from kcplan.views.arm import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
 
     arm = scenario.arm
     if states is not None and len(states):

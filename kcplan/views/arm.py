@@ -1,8 +1,9 @@
 """What the views draw of an arm: its links' meshes, posed along a path by Pinocchio.
 
-The views (:mod:`kcplan.html_view`, :mod:`kcplan.animation`, :mod:`kcplan.viz`) draw an
-arm from the triangles of its links and from the frames of its joints along a path; this
-module computes both and nothing else (it imports neither matplotlib nor plotly).
+The views (:mod:`kcplan.views.html`, :mod:`kcplan.views.animation`,
+:mod:`kcplan.views.plots`) draw an arm from the triangles of its links and from the frames
+of its joints along a path; this module computes both and nothing else (it imports
+neither matplotlib nor plotly).
 
 - :func:`arm_meshes`: one :class:`LinkMesh` per geometry of the URDF, its triangles in the
   mesh's own frame and that frame's placement in the joint that carries it, in the arm's

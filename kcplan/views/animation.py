@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 
 from kcplan.files import atomic_output
-from kcplan.viz import (  # viz selects matplotlib's non-interactive backend
+from kcplan.views.plots import (  # plots selects matplotlib's non-interactive backend
     body_shapes,
     draw_scenario,
     ellipse_outline,
@@ -100,12 +100,12 @@ def animate_arm(
 ) -> int:
     """Write a GIF of an arm moving along a path through its scene.
 
-    The links' meshes (:func:`kcplan.arm_view.arm_meshes`, at most ``max_faces``
+    The links' meshes (:func:`kcplan.views.arm.arm_meshes`, at most ``max_faces``
     triangles each) are posed by Pinocchio's forward kinematics at joint vectors
-    interpolated along ``states`` (:func:`kcplan.arm_view.joint_path`); the start (green)
+    interpolated along ``states`` (:func:`kcplan.views.arm.joint_path`); the start (green)
     and goal (red) arms stay see-through in place (their collision meshes, coarser), with
     the tip joint's path. Seen from
-    the side (:func:`kcplan.viz.arm_view_angles`).
+    the side (:func:`kcplan.views.plots.arm_view_angles`).
 
     Parameters
     ----------
@@ -131,8 +131,14 @@ def animate_arm(
     int
         The number of frames written.
     """
-    from kcplan.arm_view import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
-    from kcplan.viz import _arm_layer, _arm_limits, _draw_layers, _obstacle_layer, arm_view_angles
+    from kcplan.views.arm import arm_meshes, cover_meshes, joint_frames_along, joint_path, tip_joint
+    from kcplan.views.plots import (
+        _arm_layer,
+        _arm_limits,
+        _draw_layers,
+        _obstacle_layer,
+        arm_view_angles,
+    )
 
     scenario = as_scenario(scenario)
     arm = scenario.arm
