@@ -40,8 +40,12 @@ def __getattr__(name: str):
         import kcplan.planning.problem
 
         return getattr(kcplan.planning.problem, name)
-    if name in ("CollisionWorld", "load_scenario"):
-        import kcplan.world
+    if name == "CollisionWorld":
+        from kcplan.world import CollisionWorld
 
-        return getattr(kcplan.world, name)
+        return CollisionWorld
+    if name == "load_scenario":
+        from kcplan.scenarios import load_scenario
+
+        return load_scenario
     raise AttributeError(f"module 'kcplan' has no attribute {name!r}")

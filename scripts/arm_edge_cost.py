@@ -23,7 +23,7 @@ import time
 
 from kcplan.planning.problem import plan
 from kcplan.planning.validator import KCMotionValidator
-from kcplan.world import load_scenario
+from kcplan.scenarios import load_scenario
 
 
 class ArmCallTimer:

@@ -205,7 +205,7 @@ HANDS = {  # the link that holds it and the links that may touch it
 def held_part(robot: str, shape: str) -> Attached:
     """The part of ``--attach``: :data:`PARTS` held by the robot's hand (:data:`HANDS`); a
     mesh part is the bundled Panda's finger, twice its size."""
-    from kcplan.world import parse_scenario
+    from kcplan.scenarios import parse_scenario
 
     data = {"name": "part", "dimension": 3,
             "bounds": {"low": [-1.0, -1.0, -1.0], "high": [1.0, 1.0, 1.0]},

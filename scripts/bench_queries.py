@@ -19,7 +19,8 @@ import time
 
 import numpy as np
 
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 
 
 def random_poses(scenario, k: int, rng: np.random.Generator) -> np.ndarray:

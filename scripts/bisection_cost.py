@@ -25,8 +25,9 @@ from kcplan.planning.certifier import EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
+from kcplan.scenarios import load_scenario
 from kcplan.views.plots import plt, save_figure
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.world import CollisionWorld
 
 BINS = np.array([0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, np.inf])
 

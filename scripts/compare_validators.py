@@ -13,7 +13,8 @@ import statistics
 
 from kcplan.planning.problem import plan, seed_ompl
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 
 PAIRS = [("kc-rrtconnect", "rrtconnect"), ("kc-prm", "prm")]
 

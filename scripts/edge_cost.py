@@ -32,7 +32,8 @@ import numpy as np
 from kcplan.planning import problem
 from kcplan.planning.problem import plan
 from kcplan.planning.validator import KCMotionValidator
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 
 QUERY_KEYS = ("collision_queries", "distance_queries", "region_queries")
 

@@ -21,7 +21,7 @@ import time
 
 from kcplan.planning import problem
 from kcplan.planning import validator as V
-from kcplan.world import load_scenario
+from kcplan.scenarios import load_scenario
 
 REASONS = (
     "rejected_end_state",

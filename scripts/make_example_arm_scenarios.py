@@ -25,7 +25,7 @@ from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.problem import plan
-from kcplan.world import dump_scenario, parse_scenario
+from kcplan.scenarios import dump_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 

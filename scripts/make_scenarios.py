@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kcplan.world import dump_scenario, load_scenario
+from kcplan.scenarios import dump_scenario, load_scenario
 from kcplan.world.mesh import write_stl
 
 A2, EPS2 = [5.0, 3.5], 0.08

@@ -30,7 +30,8 @@ import numpy as np
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.kernel import KernelCertifier
 from kcplan.planning.problem import plan, seed_ompl
-from kcplan.world import CollisionWorld, load_scenario, parse_scenario
+from kcplan.scenarios import load_scenario, parse_scenario
+from kcplan.world import CollisionWorld
 
 ROOT = Path(__file__).resolve().parents[1]
 DENSITY = 0.01  # boxes per square unit

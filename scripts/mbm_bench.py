@@ -48,7 +48,7 @@ import yaml
 
 from kcplan.arm import ArmWorld
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive, mbm_scenario
-from kcplan.world import dump_scenario, parse_scenario
+from kcplan.scenarios import dump_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"

@@ -17,7 +17,8 @@ from pathlib import Path
 
 from kcplan.planning.problem import plan, seed_ompl
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 from kcplan.world.part import PartWorld
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "3d" / "hand_through_slot.yaml"

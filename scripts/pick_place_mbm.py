@@ -42,7 +42,8 @@ from kcplan.arm.kinematics import link_frames
 from kcplan.arm.mbm import load_mbm_archive, mbm_scenario
 from kcplan.files import write_text_atomic
 from kcplan.planning.problem import plan
-from kcplan.world import ScenarioError, dump_scenario, parse_scenario
+from kcplan.scenarios import dump_scenario, parse_scenario
+from kcplan.world import ScenarioError
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"

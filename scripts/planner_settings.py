@@ -24,7 +24,7 @@ TIME_LIMIT = 10.0
 _RUN = """
 import dataclasses, json, sys
 from kcplan.planning import problem
-from kcplan.world import load_scenario
+from kcplan.scenarios import load_scenario
 path, planner, key, value, seed, limit = sys.argv[1:7]
 spec = problem.PLANNERS[planner]
 value = float(value) if key == "range_factor" else int(value)

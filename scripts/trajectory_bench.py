@@ -45,8 +45,8 @@ from kcplan.arm.verify import ArmMeshChecker
 from kcplan.files import write_text_atomic
 from kcplan.planning.problem import plan
 from kcplan.planning.smoothing import certify_blends
+from kcplan.scenarios import dump_scenario, parse_scenario
 from kcplan.trajectory.curve import BlendedPath
-from kcplan.world import dump_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"

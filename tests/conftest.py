@@ -45,7 +45,7 @@ ARM_SCENE = [  # a shelf board in front of the Panda, the floor, a ball beside i
 def arm_obstacles(specs=ARM_SCENE):
     """Obstacles of a 3D scene from scenario obstacle specs (read by the rigid scenario
     loader, whose robot and bounds are placeholders)."""
-    from kcplan.world import parse_scenario
+    from kcplan.scenarios import parse_scenario
 
     data = {
         "name": "scene", "dimension": 3,

@@ -391,7 +391,8 @@ def test_link_covers_are_cut_until_they_stick_out_at_most_max_offset(tmp_path, m
     they were); ``bodies_per_link`` alone keeps the fixed count; neither is the
     default offset; a bad value is one line naming the field."""
     from kcplan.arm.model import DEFAULT_MAX_OFFSET, mesh_cover
-    from kcplan.world import ScenarioError, load_scenario
+    from kcplan.scenarios import load_scenario
+    from kcplan.world import ScenarioError
 
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path / "cache"))
     urdf = _bracket_arm(tmp_path)

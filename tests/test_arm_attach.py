@@ -11,8 +11,8 @@ from kcplan.arm import ArmError, ArmWorld, load_arm
 from kcplan.arm.attach import Attached, attach, detach
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world import ScenarioError, parse_scenario
-from kcplan.world.loading import check_start_goal
+from kcplan.scenarios import check_start_goal, parse_scenario
+from kcplan.world import ScenarioError
 
 FINGERS = ("panda_leftfinger", "panda_rightfinger")
 READY = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]

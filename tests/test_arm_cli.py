@@ -9,7 +9,8 @@ import pytest
 import yaml
 
 from kcplan.cli import main
-from kcplan.world import ScenarioError, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import ScenarioError
 
 ROOT = Path(__file__).resolve().parents[1]
 ARM = ROOT / "scenarios" / "arm"

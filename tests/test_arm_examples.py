@@ -11,7 +11,8 @@ from kcplan.arm import ArmError
 from kcplan.arm.examples import EXAMPLE_ARMS, example_folder
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.problem import plan
-from kcplan.world import ScenarioError, load_scenario, parse_scenario
+from kcplan.scenarios import load_scenario, parse_scenario
+from kcplan.world import ScenarioError
 
 ARM = Path(__file__).resolve().parents[1] / "scenarios" / "arm"
 

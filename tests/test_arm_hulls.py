@@ -36,7 +36,8 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.pairs import prove_pairs
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world import ScenarioError, parse_scenario
+from kcplan.scenarios import parse_scenario
+from kcplan.world import ScenarioError
 
 BODIES_PER_LINK = None  # the panda fixture (conftest): each link its own hull
 

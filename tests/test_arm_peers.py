@@ -15,7 +15,7 @@ from kcplan.cli import main
 from kcplan.planning.names import ARM_ONLY, JOINT_STEP
 from kcplan.planning.pin_checker import PinChecker
 from kcplan.planning.problem import PLANNERS, _arm_setup, plan
-from kcplan.world import load_scenario
+from kcplan.scenarios import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 ARM = ROOT / "scenarios" / "arm"

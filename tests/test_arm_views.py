@@ -16,8 +16,8 @@ import yaml
 
 from kcplan.arm.kinematics import body_frames
 from kcplan.cli import main
+from kcplan.scenarios import load_scenario
 from kcplan.views.arm import arm_meshes, cover_meshes, decimate, joint_path, mesh_frames
-from kcplan.world import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 PANDA = ROOT / "scenarios" / "arm" / "panda"

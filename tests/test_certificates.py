@@ -13,7 +13,8 @@ from kcplan.geometry.pose import Edge, rotate_vector
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
 from kcplan.planning.guard import BodyGuard, Guard, GuardCache
-from kcplan.world import CollisionWorld, parse_scenario
+from kcplan.scenarios import parse_scenario
+from kcplan.world import CollisionWorld
 from kcplan.world.clutter import random_pose, random_robot, random_scenario
 from kcplan.world.occupancy import CoreOccupancy
 
@@ -328,7 +329,7 @@ def test_region_queries_and_certified_edges_with_meshes():
 
     from kcplan.planning.certifier import EdgeCertifier
     from kcplan.planning.verify import verify_path
-    from kcplan.world import load_scenario
+    from kcplan.scenarios import load_scenario
 
     root = Path(__file__).resolve().parents[1]
     scenario = load_scenario(root / "scenarios" / "3d" / "open_space.yaml")
@@ -358,7 +359,7 @@ def test_an_exception_in_the_validator_is_raised_after_solve_not_through_ompl():
     from pathlib import Path
 
     from kcplan.planning.problem import plan
-    from kcplan.world import load_scenario
+    from kcplan.scenarios import load_scenario
 
     class BrokenWorld(CollisionWorld):
         def free_regions(self, pose, horizon):

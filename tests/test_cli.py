@@ -94,7 +94,7 @@ def test_output_paths_are_checked_before_any_work(argv, message, capsys):
 @pytest.mark.parametrize("yaw", [math.pi, 3.1416, -math.pi, 7.0])
 def test_start_yaw_is_normalised_for_ompl(yaw, tmp_path, capsys):
     """OMPL's SO(2) holds [-pi, pi]: a yaw outside was an invalid start and 'not solved'."""
-    from kcplan.world import load_scenario
+    from kcplan.scenarios import load_scenario
 
     text = Path(OPEN_FIELD).read_text()
     data = __import__("yaml").safe_load(text)

@@ -525,7 +525,7 @@ def test_robot_fit_writes_a_robot_block_a_scenario_accepts(tmp_path, capsys):
     path = tmp_path / "scenario.yaml"
     path.write_text(yaml.safe_dump(scenario))
     from kcplan.cover.bodies import body_holds
-    from kcplan.world import load_scenario
+    from kcplan.scenarios import load_scenario
 
     robot = load_scenario(path, check=False).robot
     solid = read_solid(MESHES / "panda_hand.stl")

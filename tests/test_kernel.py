@@ -46,7 +46,8 @@ from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.states import set_state, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, Scenario, load_scenario, parse_scenario
+from kcplan.scenarios import load_scenario, parse_scenario
+from kcplan.world import CollisionWorld, Scenario
 from kcplan.world.clutter import random_obstacles, random_pose
 from kcplan.world.collision import CLEARANCE_RTOL
 

@@ -26,7 +26,8 @@ from kcplan.maps.superquadric import (
 )
 from kcplan.planning.problem import plan
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 
 EXTERNAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "external"
 HRM = EXTERNAL / "hrm" / "resources"

@@ -21,7 +21,8 @@ from kcplan.planning.names import ARM_ONLY, CERTIFIABLE
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, load_scenario
+from kcplan.scenarios import load_scenario
+from kcplan.world import CollisionWorld
 from kcplan.world.clutter import random_pose, random_scenario
 
 ROOT = Path(__file__).resolve().parent.parent

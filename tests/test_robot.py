@@ -13,7 +13,8 @@ from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.verify import verify_path
-from kcplan.world import CollisionWorld, ScenarioError, dump_scenario, load_scenario, parse_scenario
+from kcplan.scenarios import dump_scenario, load_scenario, parse_scenario
+from kcplan.world import CollisionWorld, ScenarioError
 from kcplan.world.clutter import random_pose, random_robot, random_scenario
 
 L_SHAPE = {

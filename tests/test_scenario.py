@@ -13,13 +13,8 @@ from hypothesis import strategies as st
 
 from kcplan.cli import main
 from kcplan.geometry.polygon import convex_pieces, polygon_area
-from kcplan.world import (
-    ScenarioError,
-    dump_scenario,
-    load_scenario,
-    parse_scenario,
-    scenario_to_dict,
-)
+from kcplan.scenarios import dump_scenario, load_scenario, parse_scenario
+from kcplan.world import ScenarioError, scenario_to_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 # the rigid suite (arm scenarios, scenarios/arm/, have tests of their own: test_arm_cli.py)

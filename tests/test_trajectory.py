@@ -125,7 +125,7 @@ def test_limits_are_refused_in_one_line():
 def box():
     from kcplan.arm import ArmWorld
     from kcplan.arm.verify import ArmMeshChecker
-    from kcplan.world.scenario import as_scenario
+    from kcplan.scenarios import as_scenario
 
     scenario = as_scenario(BOX)
     world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)

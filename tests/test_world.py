@@ -15,7 +15,8 @@ from scipy.optimize import minimize_scalar
 from scipy.spatial import ConvexHull
 
 from kcplan.geometry.pose import pose_frame
-from kcplan.world import CollisionWorld, parse_scenario
+from kcplan.scenarios import parse_scenario
+from kcplan.world import CollisionWorld
 
 
 def world_2d(obstacles, a=(5.0, 3.5), bounds=((-100, -100), (100, 100))):

@@ -52,10 +52,10 @@ from kcplan.arm.examples import example_robot
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
 from kcplan.world.scenario import (
     MAX_OBSTACLES,
+    FieldReader,
     Obstacle,
     ScenarioError,
-    _obstacle,
-    _Reader,
+    parse_obstacle,
 )
 
 __all__ = ["ArmScenario", "arm_scenario_to_dict", "parse_arm_scenario"]
@@ -91,7 +91,7 @@ class ArmScenario:
         return self.arm
 
 
-def _cylinder(r: _Reader, spec: Any, index: int) -> Obstacle:
+def _cylinder(r: FieldReader, spec: Any, index: int) -> Obstacle:
     where = f"obstacles[{index}].cylinder"
     spec = r.mapping(spec, where, ("center", "radius", "height"), ("quaternion",))
     center = r.vector(spec["center"], f"{where}.center", 3)
@@ -101,7 +101,7 @@ def _cylinder(r: _Reader, spec: Any, index: int) -> Obstacle:
     return Obstacle("cylinder", index, spec, center, R, np.array([radius, radius, 0.5 * height]))
 
 
-def _joints(r: _Reader, value: Any, where: str, arm: ArmModel) -> NDArray[np.float64]:
+def _joints(r: FieldReader, value: Any, where: str, arm: ArmModel) -> NDArray[np.float64]:
     spec = r.mapping(value, where, ("joints",))
     q = r.vector(spec["joints"], f"{where}.joints", arm.dof)
     q, clamped, outside = arm.clamp(q)
@@ -122,7 +122,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     ScenarioError
         One line naming the source, the field and what was expected.
     """
-    r = _Reader(source)
+    r = FieldReader(source)
     top = r.mapping(
         data, "top level", ("name", "robot", "start", "goal"),
         ("dimension", "description", "obstacles", "allowed", "attached"),
@@ -214,7 +214,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         if isinstance(item, dict) and len(item) == 1 and "cylinder" in item:
             obstacles.append(_cylinder(r, item["cylinder"], i))
         else:
-            obstacles.append(_obstacle(r, item, i, 3, directory))
+            obstacles.append(parse_obstacle(r, item, i, 3, directory))
     allowed = _allowed(r, top.get("allowed") or [])
     return ArmScenario(
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
@@ -222,7 +222,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     )  # fmt: skip
 
 
-def _attached(r: _Reader, value: Any, directory: Path) -> list[Attached]:
+def _attached(r: FieldReader, value: Any, directory: Path) -> list[Attached]:
     """The objects the arm holds: ``[{link, name, box|cylinder|sphere|mesh: {...}, touch}]``,
     each shape's fields those of an obstacle, in the link's frame."""
     if not isinstance(value, list):
@@ -239,7 +239,7 @@ def _attached(r: _Reader, value: Any, directory: Path) -> list[Attached]:
         if kind == "cylinder":
             shape = _cylinder(r, spec[kind], i)
         else:
-            shape = _obstacle(r, {kind: spec[kind]}, i, 3, directory)
+            shape = parse_obstacle(r, {kind: spec[kind]}, i, 3, directory)
         touch = spec.get("touch", [])
         if not isinstance(touch, list) or not all(map(_is_text, touch)):
             r.fail(f"{where}.touch", "a list of link names", touch)
@@ -248,7 +248,7 @@ def _attached(r: _Reader, value: Any, directory: Path) -> list[Attached]:
     return out
 
 
-def _allowed(r: _Reader, value: Any) -> frozenset:
+def _allowed(r: FieldReader, value: Any) -> frozenset:
     """Link pairs allowed to touch; names outside the robot are kept (MoveIt's matrix
     lists the scene's objects too)."""
     if not isinstance(value, list):

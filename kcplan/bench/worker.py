@@ -37,7 +37,8 @@ def execute(spec: dict) -> dict:
     t0 = time.perf_counter()
     from kcplan.planning.problem import plan
     from kcplan.planning.verify import verify_path
-    from kcplan.world import CollisionWorld, load_scenario
+    from kcplan.scenarios import load_scenario
+    from kcplan.world import CollisionWorld
 
     scenario = load_scenario(spec["scenario"])
     arm = getattr(scenario, "arm", None) is not None

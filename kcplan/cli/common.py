@@ -50,7 +50,8 @@ def output_file(path: str | None, option: str, suffixes: tuple[str, ...] = ()) -
 
 def load_input(path: str, check: bool = True):
     """Load a scenario, turning every problem with it into an :class:`InputError`."""
-    from kcplan.world import ScenarioError, load_scenario
+    from kcplan.scenarios import load_scenario
+    from kcplan.world import ScenarioError
 
     try:
         return load_scenario(path, check=check)

@@ -13,7 +13,8 @@ from kcplan.cli.common import InputError, Parser, output_file, positive_float, p
 def run(args: argparse.Namespace) -> int:
     """Convert the map, validate the scenario, then write it."""
     from kcplan.maps import MapImportError
-    from kcplan.world import ScenarioError, dump_scenario, parse_scenario
+    from kcplan.scenarios import dump_scenario, parse_scenario
+    from kcplan.world import ScenarioError
 
     out = Path(args.output)
     output_file(args.output, "-o", (".yaml", ".yml"))
@@ -51,7 +52,8 @@ def run(args: argparse.Namespace) -> int:
 def _run_mbm(args: argparse.Namespace, out: Path) -> int:
     """One MotionBenchMaker problem, from its two files or from the archive."""
     from kcplan.arm.mbm import MbmError, mbm_scenario, read_mbm_archive, read_mbm_problem
-    from kcplan.world import ScenarioError, dump_scenario, parse_scenario
+    from kcplan.scenarios import dump_scenario, parse_scenario
+    from kcplan.world import ScenarioError
 
     files = [args.scene, args.request]
     try:

@@ -8,7 +8,8 @@ import sys
 
 def run(args: argparse.Namespace) -> int:
     """Check each scenario file; exit 2 when any is invalid."""
-    from kcplan.world import ScenarioError, load_scenario
+    from kcplan.scenarios import load_scenario
+    from kcplan.world import ScenarioError
 
     failed = 0
     for path in args.scenarios:

@@ -193,7 +193,8 @@ def import_movingai(
         Robot semi-axes; default ``[0.7 w cell, 0.4 w cell]`` for the narrowest corridor
         ``w`` (:func:`narrowest_corridor`).
     """
-    from kcplan.world import CollisionWorld, parse_scenario
+    from kcplan.scenarios import parse_scenario
+    from kcplan.world import CollisionWorld
 
     blocked = read_grid(map_path)
     H, W = blocked.shape

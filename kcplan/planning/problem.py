@@ -40,8 +40,9 @@ from kcplan.planning.states import (
 )
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import PathCheck, verify_path
+from kcplan.scenarios import as_scenario
 from kcplan.world.collision import CollisionWorld
-from kcplan.world.scenario import Scenario, as_scenario
+from kcplan.world.scenario import Scenario
 
 __all__ = ["PLANNERS", "PlannerSpec", "PlanResult", "plan", "seed_ompl"]
 
@@ -367,7 +368,7 @@ def plan(
     Parameters
     ----------
     scenario : Scenario or path-like
-        A scenario, or the path of a scenario file (:func:`kcplan.world.scenario.as_scenario`).
+        A scenario, or the path of a scenario file (:func:`kcplan.scenarios.as_scenario`).
     planner : str
         A key of :data:`PLANNERS`.
     time_limit : float

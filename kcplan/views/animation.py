@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 
 from kcplan.files import atomic_output
+from kcplan.scenarios import as_scenario
 from kcplan.views.plots import (  # plots selects matplotlib's non-interactive backend
     body_shapes,
     draw_scenario,
@@ -17,7 +18,7 @@ from kcplan.views.plots import (  # plots selects matplotlib's non-interactive b
     path_poses,
     scenario_axes,
 )
-from kcplan.world.scenario import Scenario, as_scenario
+from kcplan.world.scenario import Scenario
 
 __all__ = ["animate_arm", "animate_path"]
 

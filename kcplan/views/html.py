@@ -18,9 +18,10 @@ import plotly.graph_objects as go
 from kcplan.files import write_text_atomic
 from kcplan.geometry.pose import pose_frame
 from kcplan.maps.superquadric import unit_normals
+from kcplan.scenarios import as_scenario
 from kcplan.views.plots import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
-from kcplan.world.scenario import Obstacle, Scenario, as_scenario
+from kcplan.world.scenario import Obstacle, Scenario
 from kcplan.world.support import box_vertices
 
 __all__ = ["cover_figure", "scene_figure", "write_cover_html", "write_scene_html"]

@@ -20,7 +20,8 @@ from kcplan.files import atomic_output  # noqa: E402
 from kcplan.geometry.pose import Edge, pose_frame  # noqa: E402
 from kcplan.geometry.robot import Robot  # noqa: E402
 from kcplan.kc.convex import ConvexLowerBound  # noqa: E402
-from kcplan.world.scenario import Scenario, as_scenario  # noqa: E402
+from kcplan.scenarios import as_scenario  # noqa: E402
+from kcplan.world.scenario import Scenario
 
 __all__ = [
     "save_figure",

@@ -1,16 +1,15 @@
-"""Scenario files (YAML) and the FCL collision world.
+"""Rigid robots' scenario files (YAML) and the FCL collision world.
 
-Independent of OMPL; the only module that imports python-fcl is :mod:`.collision`.
+Independent of OMPL and of arms; the only module that imports python-fcl is
+:mod:`.collision`. Scenario files of every robot kind are read by :mod:`kcplan.scenarios`.
 """
 
 from kcplan.world.collision import CollisionWorld
-from kcplan.world.loading import check_start_goal, load_scenario, parse_scenario
 from kcplan.world.scenario import (
     DEFAULT_INFLATION,
     Obstacle,
     Scenario,
     ScenarioError,
-    dump_scenario,
     scenario_to_dict,
 )
 
@@ -20,9 +19,5 @@ __all__ = [
     "Obstacle",
     "Scenario",
     "ScenarioError",
-    "check_start_goal",
-    "dump_scenario",
-    "load_scenario",
-    "parse_scenario",
     "scenario_to_dict",
 ]

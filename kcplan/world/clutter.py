@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kcplan.geometry.robot import Body, Robot
-from kcplan.world.scenario import Scenario, parse_scenario
+from kcplan.world.scenario import Scenario, parse_rigid_scenario
 
 __all__ = ["random_pose", "random_obstacles", "random_robot", "random_scenario"]
 
@@ -90,4 +90,4 @@ def random_scenario(
         "goal": {"position": [1] + [0] * (n - 1)},
         "obstacles": random_obstacles(rng, n, count, half_width - 5.0),
     }
-    return parse_scenario(data)
+    return parse_rigid_scenario(data)

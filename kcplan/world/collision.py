@@ -38,7 +38,7 @@ from kcplan._kernel import _core, build_kernel_world
 from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
 from kcplan.world.region import FreeRegion
-from kcplan.world.scenario import Obstacle, Scenario, as_scenario
+from kcplan.world.scenario import Obstacle, Scenario, as_rigid_scenario
 from kcplan.world.support import EllipsoidSupport, box_vertices, piece_supports, separation
 
 __all__ = [
@@ -156,7 +156,7 @@ class CollisionWorld:
     def __init__(
         self, scenario: Scenario | str | os.PathLike, robot: Robot | ArrayLike | None = None
     ):
-        scenario = as_scenario(scenario, rigid=True)
+        scenario = as_rigid_scenario(scenario)
         n = scenario.dimension
         if robot is None:
             robot = scenario.robot

@@ -1,4 +1,8 @@
-"""Scenario files: the YAML format, its validating loader and its writer.
+"""Scenario files of rigid robots: the YAML format, its validating reader, and the pieces
+every scenario format shares (the file's YAML, :class:`FieldReader`'s one-line errors,
+obstacles). An arm's scenario is :mod:`kcplan.arm.scenario`'s; :mod:`kcplan.scenarios`
+reads and writes either, dispatching on the robot's kind in one place. This module knows
+nothing of arms but how to recognise one's file (:func:`is_arm_data`).
 
 A scenario is one planning problem: a robot made of one or more ellipses (2D) or
 ellipsoids (3D) (:class:`kcplan.geometry.robot.Robot`), a box for the robot's origin, a
@@ -39,14 +43,17 @@ __all__ = [
     "MAX_SCENARIO_BYTES",
     "MAX_OBSTACLES",
     "MAX_POLYGON_VERTICES",
+    "FieldReader",
     "Obstacle",
     "Scenario",
     "ScenarioError",
-    "as_scenario",
-    "load_scenario",
-    "parse_scenario",
+    "as_rigid_scenario",
+    "is_arm_data",
+    "parse_obstacle",
+    "parse_rigid_scenario",
+    "read_scenario_data",
     "scenario_to_dict",
-    "dump_scenario",
+    "write_scenario_yaml",
 ]
 
 DEFAULT_INFLATION = 0.1
@@ -187,7 +194,7 @@ def _show(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-class _Reader:
+class FieldReader:
     """Typed access to parsed YAML with errors that name the file and field."""
 
     def __init__(self, source: str):
@@ -304,7 +311,7 @@ class _Reader:
         return np.concatenate([position, q])
 
 
-def _mesh_robot(r: _Reader, spec: dict, n: int, directory: Path) -> tuple[Robot, Any]:
+def _mesh_robot(r: FieldReader, spec: dict, n: int, directory: Path) -> tuple[Robot, Any]:
     """``robot: {mesh: FILE, bodies: K, scale: S, hull: false}``: the cover of the part
     (:func:`kcplan.cover.cache.cached_cover`) and the part itself."""
     from kcplan.cover.cache import cached_cover
@@ -331,7 +338,7 @@ def _mesh_robot(r: _Reader, spec: dict, n: int, directory: Path) -> tuple[Robot,
     return cover.robot, cover.solid
 
 
-def _robot(r: _Reader, value: Any, n: int, directory: Path) -> tuple[Robot, float, Any]:
+def _robot(r: FieldReader, value: Any, n: int, directory: Path) -> tuple[Robot, float, Any]:
     """The ``robot`` mapping: the robot (``semi_axes``: one body at the origin,
     ``bodies``, or a ``mesh`` to cover), its guard inflation and the mesh's part (or
     None)."""
@@ -365,7 +372,7 @@ def _robot(r: _Reader, value: Any, n: int, directory: Path) -> tuple[Robot, floa
     return Robot(bodies), inflation, None
 
 
-def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Obstacle:
+def parse_obstacle(r: FieldReader, value: Any, index: int, n: int, directory: Path) -> Obstacle:
     where = f"obstacles[{index}]"
     kinds = OBSTACLE_KINDS[n]
     if not isinstance(value, dict) or len(value) != 1:
@@ -441,9 +448,19 @@ def _obstacle(r: _Reader, value: Any, index: int, n: int, directory: Path) -> Ob
     return Obstacle(kind, index, spec, position, R, zeros, (), world, triangles)
 
 
-def parse_scenario(data: Any, source: str = "<string>", directory: Path | None = None) -> Scenario:
-    """Validate parsed YAML and build a :class:`Scenario` (the format only: whether the
-    start and goal are free is checked by :func:`kcplan.world.loading.parse_scenario`).
+def is_arm_data(data: Any) -> bool:
+    """Whether parsed scenario YAML describes an arm (its robot names a ``urdf`` or an
+    ``example``): :mod:`kcplan.scenarios` reads it with :mod:`kcplan.arm.scenario`."""
+    robot = data.get("robot") if isinstance(data, dict) else None
+    return isinstance(robot, dict) and ("urdf" in robot or "example" in robot)
+
+
+def parse_rigid_scenario(
+    data: Any, source: str = "<string>", directory: Path | None = None
+) -> Scenario:
+    """Validate parsed YAML of a rigid robot's scenario and build a :class:`Scenario` (the
+    format only; :func:`kcplan.scenarios.parse_scenario` reads every kind of robot and
+    checks that the start and goal are free).
 
     Parameters
     ----------
@@ -459,13 +476,11 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
     ScenarioError
         One-line message naming the source, the field and what was expected.
     """
-    r = _Reader(source)
+    r = FieldReader(source)
     directory = Path.cwd() if directory is None else directory
-    robot = data.get("robot") if isinstance(data, dict) else None
-    if isinstance(robot, dict) and ("urdf" in robot or "example" in robot):
-        from kcplan.arm.scenario import parse_arm_scenario  # an arm: its own format
-
-        return parse_arm_scenario(data, source, directory)
+    if is_arm_data(data):
+        r.fail("robot", "a rigid robot (an arm's scenario is read by kcplan.scenarios)",
+               data["robot"])  # fmt: skip
     top = r.mapping(
         data,
         "top level",
@@ -501,7 +516,7 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
         r.fail("obstacles", "a list of obstacles", items)
     if len(items) > MAX_OBSTACLES:
         r.fail("obstacles", f"at most {MAX_OBSTACLES} obstacles", None, f"{len(items)}")
-    obstacles = tuple(_obstacle(r, item, i, n, directory) for i, item in enumerate(items))
+    obstacles = tuple(parse_obstacle(r, item, i, n, directory) for i, item in enumerate(items))
     scenario = Scenario(
         name,
         n,
@@ -519,9 +534,10 @@ def parse_scenario(data: Any, source: str = "<string>", directory: Path | None =
     return scenario
 
 
-def load_scenario(path: str | os.PathLike) -> Scenario:
-    """Read and validate a scenario file (the format only; see
-    :func:`kcplan.world.loading.load_scenario` for the start and goal check).
+def read_scenario_data(path: str | os.PathLike) -> tuple[Any, str, Path]:
+    """Read a scenario file's YAML: ``(data, source, directory)``, ``source`` the path as
+    given (for messages), ``directory`` the file's folder (mesh paths are relative to it);
+    any robot's (:func:`kcplan.scenarios.load_scenario` parses it).
 
     Parameters
     ----------
@@ -531,8 +547,8 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
     Raises
     ------
     ScenarioError
-        For every problem with the file: unreadable, too large, not YAML, YAML syntax
-        errors (with line and column), and every invalid field.
+        For a file that is unreadable, too large, not YAML, or has YAML syntax errors
+        (with line and column).
     """
     source = os.fspath(path)
     p = Path(path)
@@ -559,33 +575,34 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
         raise ScenarioError(f"{source}: {where}YAML syntax error: {problem}") from None
     except (yaml.YAMLError, RecursionError) as err:
         raise ScenarioError(f"{source}: YAML syntax error: {type(err).__name__}") from None
-    return parse_scenario(data, source, p.resolve().parent)
+    return data, source, p.resolve().parent
 
 
-def as_scenario(value: Scenario | str | os.PathLike, rigid: bool = False) -> Scenario:
-    """The scenario a public entry point was given: ``value`` itself when it is a
-    :class:`Scenario` (or an arm's :class:`kcplan.arm.scenario.ArmScenario`), the file it
-    names when it is a path (``str`` or ``os.PathLike``, read by :func:`load_scenario`).
-    ``rigid``: the caller handles rigid robots only (such as :class:`kcplan.world.CollisionWorld`).
+def as_rigid_scenario(value: Scenario | str | os.PathLike) -> Scenario:
+    """The rigid robot's scenario a rigid-only entry point (such as
+    :class:`kcplan.world.CollisionWorld`) was given: ``value`` itself when it is a
+    :class:`Scenario`, the file it names when it is a path (``str`` or ``os.PathLike``).
 
     Raises
     ------
     TypeError
-        For anything else, saying what is expected, and for an arm when ``rigid``.
+        For anything else, an arm's scenario or file among them, saying what is expected.
     ScenarioError
         For a path whose file is not a valid scenario.
     """
-    from kcplan.arm.scenario import ArmScenario
-
     if isinstance(value, (str, os.PathLike)):
-        value = load_scenario(value)
-    if isinstance(value, ArmScenario) and rigid:
+        data, source, directory = read_scenario_data(value)
+        if is_arm_data(data):
+            raise TypeError(f"scenario: {source}: expected a rigid robot of ellipsoids, got "
+                            "an arm (an arm's scene is a kcplan.arm.ArmWorld)")  # fmt: skip
+        value = parse_rigid_scenario(data, source, directory)
+    if isinstance(value, Scenario):
+        return value
+    if hasattr(value, "arm"):
         raise TypeError(
             f"scenario: {value.source}: expected a rigid robot of ellipsoids, got an "
             f"{value.arm.describe()} (an arm's scene is a kcplan.arm.ArmWorld)"
         )
-    if isinstance(value, (Scenario, ArmScenario)):
-        return value
     raise TypeError(
         "scenario: expected a kcplan Scenario or the path of a scenario file (str or "
         f"os.PathLike), got {type(value).__name__}"
@@ -618,16 +635,8 @@ def scenario_to_dict(scenario: Scenario) -> dict:
     return out
 
 
-def dump_scenario(scenario, path: str | os.PathLike) -> None:
-    """Write a scenario (or its dict) as YAML, atomically (temporary file, then rename)."""
-    if isinstance(scenario, dict):
-        data = scenario
-    elif isinstance(scenario, Scenario):
-        data = scenario_to_dict(scenario)
-    else:
-        from kcplan.arm.scenario import arm_scenario_to_dict
-
-        data = arm_scenario_to_dict(scenario)
+def write_scenario_yaml(data: dict, path: str | os.PathLike) -> None:
+    """Write a scenario's plain data as YAML, atomically (temporary file, then rename)."""
     write_text_atomic(
         path, yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
     )
