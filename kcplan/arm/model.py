@@ -72,6 +72,7 @@ __all__ = [
     "mesh_cover",
     "package_folders",
     "self_pairs_of",
+    "movable_joints",
 ]
 
 DEFAULT_MAX_OFFSET = 0.01
@@ -256,6 +257,24 @@ class ArmModel:
             and (q >= self.lower).all()
             and (q <= self.upper).all()
         )
+
+
+def movable_joints(urdf: str | os.PathLike) -> list[str]:
+    """Every joint of the URDF that kcplan can move (revolute or prismatic), in the URDF's
+    order: the planning group when none is named.
+
+    Raises
+    ------
+    ArmError
+        ``URDF: urdf: expected a readable URDF, got: ...`` for a file Pinocchio cannot read.
+    """
+    import pinocchio as pin
+
+    try:
+        full = pin.buildModelFromUrdf(os.fspath(urdf))
+    except (RuntimeError, ValueError, OSError) as err:
+        raise ArmError(f"{urdf}: urdf: expected a readable URDF, got: {err}") from None
+    return [n for n in full.names[1:] if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]
 
 
 def load_arm(

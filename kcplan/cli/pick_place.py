@@ -74,24 +74,14 @@ def _arm(args: argparse.Namespace):
         return PAPER_JOINTS, None, "KUKA LWR 4 (paper Table 2, DH)"
     from kcplan.arm import ArmError, load_arm
     from kcplan.arm.kinematics import link_frames
+    from kcplan.arm.model import movable_joints
 
     if not Path(args.urdf).is_file():
         raise InputError(f"{args.urdf}: --urdf: expected an existing URDF file")
     if not args.link:
         raise InputError(f"{args.urdf}: --link: expected the link that holds the object")
-    joints = args.joints
-    if not joints:
-        import pinocchio as pin
-
-        from kcplan.arm.model import JOINT_KINDS
-
-        try:
-            full = pin.buildModelFromUrdf(args.urdf)
-        except (RuntimeError, ValueError, OSError) as err:
-            raise InputError(f"{args.urdf}: urdf: expected a readable URDF, got: {err}") from None
-        joints = [n for n in full.names[1:]
-                  if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]  # fmt: skip
     try:
+        joints = args.joints or movable_joints(args.urdf)
         arm = load_arm(args.urdf, joints, package_dirs=args.package_dir)
     except ArmError as err:
         raise InputError(str(err)) from None

@@ -114,24 +114,15 @@ def run_info(args: argparse.Namespace) -> int:
     import numpy as np
 
     from kcplan.arm import ArmError, load_arm
-    from kcplan.arm.model import JOINT_KINDS
+    from kcplan.arm.model import movable_joints
     from kcplan.arm.pairs import prove_pairs
 
     for key, path in (("urdf", args.urdf), ("srdf", args.srdf)):
         if path is not None and not Path(path).is_file():
             raise InputError(f"{path}: {key}: expected an existing {key.upper()} file")
-    joints = args.joints
-    if not joints:  # every movable joint of the URDF, in its order
-        import pinocchio as pin
-
-        try:
-            full = pin.buildModelFromUrdf(args.urdf)
-        except (RuntimeError, ValueError, OSError) as err:
-            raise InputError(f"{args.urdf}: urdf: expected a readable URDF, got: {err}") from None
-        joints = [n for n in full.names[1:]
-                  if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]  # fmt: skip
     t0 = time.perf_counter()
     try:
+        joints = args.joints or movable_joints(args.urdf)  # every movable joint, in order
         arm = load_arm(args.urdf, joints, srdf=args.srdf, package_dirs=args.package_dir)
     except ArmError as err:
         raise InputError(str(err)) from None

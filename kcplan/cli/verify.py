@@ -152,16 +152,9 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
         piece, s = check.where
         problems.append(f"COLLISION of the links' meshes ({check.what}) on piece {piece} of "
                         f"the curve at {s:.6f} of it")  # fmt: skip
-    if problems:
-        print("; ".join(problems) + f" ({check.queries} distance queries)")
-        return 1
-    print(f"clean: the links' meshes along the whole curve ({pieces} pieces, "
-          f"{int((file.path.blends > 0).sum())} blends) checked without gaps, minimum "
-          f"clearance {check.min_clearance:.6g}, {check.queries} distance queries; "
-          f"{len(file.t)} samples on the curve (within {off['curve']:.1g} rad), peaks "
-          f"{off['velocity']:.6f} of the velocity and {off['acceleration']:.6f} of the "
-          "acceleration limits")  # fmt: skip
-    return 0
+    checked = (f"the links' meshes along the whole curve ({pieces} pieces, "
+               f"{int((file.path.blends > 0).sum())} blends)")  # fmt: skip
+    return _report(problems, checked, check, "distance", len(file.t), off)
 
 
 def _sample_problems(off: dict) -> list[str]:
@@ -203,14 +196,19 @@ def _verify_rigid_trajectory(args: argparse.Namespace, scenario, data: dict) -> 
     if check.collides:
         problems.append(f"COLLISION{f' of {part}' if part else ''} on edge {check.edge_index} "
                         f"at s = {check.s:.6f}")  # fmt: skip
+    checked = f"{f'{part}, ' if part else ''}{len(file.waypoints) - 1} edges"
+    return _report(problems, checked, check, "clearance", len(file.t), off)
+
+
+def _report(problems: list[str], checked: str, check, kind: str, samples: int, off: dict) -> int:
+    """Print a trajectory's verdict in one line; exit 1 with its problems, else 0."""
     if problems:
-        print("; ".join(problems) + f" ({check.queries} clearance queries)")
+        print("; ".join(problems) + f" ({check.queries} {kind} queries)")
         return 1
-    print(f"clean: {f'{part}, ' if part else ''}{len(file.waypoints) - 1} edges checked without "
-          f"gaps, minimum clearance {check.min_clearance:.6g}, {check.queries} clearance "
-          f"queries; {len(file.t)} samples on the path (within {off['curve']:.1g}), peaks "
-          f"{off['velocity']:.6f} of the speed and {off['acceleration']:.6f} of the "
-          "acceleration limits")  # fmt: skip
+    print(f"clean: {checked} checked without gaps, minimum clearance "
+          f"{check.min_clearance:.6g}, {check.queries} {kind} queries; {samples} samples on "
+          f"the curve (within {off['curve']:.1g}), peaks {off['velocity']:.6f} of the "
+          f"velocity and {off['acceleration']:.6f} of the acceleration limits")  # fmt: skip
     return 0
 
 

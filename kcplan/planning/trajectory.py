@@ -97,6 +97,30 @@ def joint_limits(
     return v, a
 
 
+def _csv(header: list[str], *columns: NDArray[np.float64]) -> str:
+    """Samples as CSV: the header, then one row per sample, every digit kept."""
+    rows = np.column_stack(columns)
+    lines = [",".join(header)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+def _field(data: dict, field: str, shape: tuple, value=None) -> NDArray[np.float64]:
+    """A trajectory file's numeric field of ``shape`` (``value`` in place of
+    ``data[field]`` when given), or ``FIELD: expected ...`` (ValueError)."""
+    source = data.get(field) if value is None else value
+    if source is None:
+        raise ValueError(f"{field}: expected the field (a trajectory file of kcplan plan "
+                         "--trajectory)")  # fmt: skip
+    try:
+        x = np.array(source, dtype=float)
+    except (TypeError, ValueError):
+        x = np.zeros(0)
+    if x.shape != shape or not np.isfinite(x).all():
+        raise ValueError(f"{field}: expected finite numbers of shape {shape}, got "
+                         f"{x.shape if x.size else 'none'}")  # fmt: skip
+    return x
+
+
 @dataclass(frozen=True, eq=False)
 class CertifiedTrajectory:
     """A timed trajectory along a certified curve.
@@ -169,9 +193,7 @@ class CertifiedTrajectory:
         """The samples as CSV: ``t``, then ``q_``, ``qd_`` and ``qdd_`` of each joint."""
         t, _, q, qd, qdd = self.timed.sample(rate)
         header = ["t"] + [f"{p}_{name}" for p in ("q", "qd", "qdd") for name in self.joints]
-        rows = np.column_stack([t, q, qd, qdd])
-        lines = [",".join(header)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
-        return "\n".join(lines) + "\n"
+        return _csv(header, t, q, qd, qdd)
 
 
 def certified_trajectory(
@@ -245,19 +267,6 @@ def read_trajectory(data: dict, dof: int) -> TrajectoryFile:
         ``FIELD: expected ...`` for the first field that is missing or malformed.
     """
 
-    def array(field: str, shape: tuple) -> NDArray[np.float64]:
-        try:
-            x = np.array(data[field], dtype=float)
-        except KeyError:
-            raise ValueError(f"{field}: expected the field (a trajectory file of kcplan plan "
-                             "--trajectory)") from None  # fmt: skip
-        except (TypeError, ValueError):
-            x = np.zeros(0)
-        if x.shape != shape or not np.isfinite(x).all():
-            raise ValueError(f"{field}: expected finite numbers of shape {shape}, got "
-                             f"{x.shape if x.size else 'none'}")  # fmt: skip
-        return x
-
     curve = data.get("curve")
     if not isinstance(curve, dict):
         raise ValueError("curve: expected {waypoints, blends}: the certified curve")
@@ -277,17 +286,10 @@ def read_trajectory(data: dict, dof: int) -> TrajectoryFile:
     if t is None or t.ndim != 1 or len(t) < 2:
         raise ValueError("t: expected a list of at least two sample times (s)")
     m = len(t)
-    return TrajectoryFile(
-        tuple(data.get("joints") or ()),
-        path,
-        array("t", (m,)),
-        array("s", (m,)),
-        array("q", (m, dof)),
-        array("qd", (m, dof)),
-        array("qdd", (m, dof)),
-        array("velocity_limits", (dof,)),
-        array("acceleration_limits", (dof,)),
-    )
+    shapes = {"t": (m,), "s": (m,), "q": (m, dof), "qd": (m, dof), "qdd": (m, dof),
+              "velocity_limits": (dof,), "acceleration_limits": (dof,)}  # fmt: skip
+    fields = {name: _field(data, name, shape) for name, shape in shapes.items()}
+    return TrajectoryFile(tuple(data.get("joints") or ()), path, **fields)
 
 
 POSE_NAMES = {2: ("x", "y", "yaw"), 3: ("x", "y", "z", "qx", "qy", "qz", "qw")}
@@ -375,10 +377,7 @@ class RigidTimedPath:
         """The samples as CSV: ``t``, the pose, its velocity and acceleration."""
         t, _, q, qd, qdd = self.timed.sample(rate)
         names = VELOCITY_NAMES[self.timed.dimension]
-        header = ["t", *self.joints, *names, *(f"d{name}" for name in names)]
-        rows = np.column_stack([t, q, qd, qdd])
-        lines = [",".join(header)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
-        return "\n".join(lines) + "\n"
+        return _csv(["t", *self.joints, *names, *(f"d{name}" for name in names)], t, q, qd, qdd)
 
 
 def timed_rigid_path(
@@ -463,20 +462,8 @@ def read_rigid_trajectory(data: dict, dimension: int) -> RigidTrajectoryFile:
     m = len(t)
     shapes = {"t": (m,), "s": (m,), "q": (m, width), "qd": (m, twist), "qdd": (m, twist),
               "velocity_limits": (2,), "acceleration_limits": (2,)}  # fmt: skip
-    out = {}
-    for field, shape in (("curve.waypoints", None), *shapes.items()):
-        source = curve.get("waypoints") if field == "curve.waypoints" else data.get(field)
-        if source is None:
-            raise ValueError(f"{field}: expected the field (a trajectory file of kcplan plan "
-                             "--trajectory)")  # fmt: skip
-        try:
-            x = np.array(source, dtype=float)
-        except (TypeError, ValueError):
-            x = np.zeros(0)
-        ok = (x.ndim == 2 and x.shape[1] == width and len(x) >= 2) if shape is None else (
-            x.shape == shape)  # fmt: skip
-        if not ok or not np.isfinite(x).all():
-            want = f"poses of {width} numbers" if shape is None else f"shape {shape}"
-            raise ValueError(f"{field}: expected finite numbers, {want}")
-        out[field] = x
-    return RigidTrajectoryFile(dimension, out.pop("curve.waypoints"), **out)
+    fields = {name: _field(data, name, shape) for name, shape in shapes.items()}
+    waypoints = curve.get("waypoints")
+    count = len(waypoints) if isinstance(waypoints, list) else 0
+    W = _field(data, "curve.waypoints", (max(count, 2), width), waypoints or [])
+    return RigidTrajectoryFile(dimension, W, **fields)

@@ -14,7 +14,6 @@ corner, and each edge is one its planner certified. Imports neither OMPL nor FCL
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kcplan.geometry.pose import Edge, pose_size
 from kcplan.trajectory.curve import BlendedPath
-from kcplan.trajectory.timing import time_path
+from kcplan.trajectory.timing import sample_times, time_path
 
 __all__ = [
     "DEFAULT_RIGID_ACCELERATIONS",
@@ -100,11 +99,7 @@ class RigidTrajectory:
 
     def sample(self, rate: float) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
         """``(t, s, pose, velocity, acceleration)`` every ``1 / rate`` s, the end included."""
-        if not (rate > 0 and math.isfinite(rate)):
-            raise ValueError(f"rate: expected a finite number of samples per second > 0, "
-                             f"got {rate!r}")  # fmt: skip
-        t = np.arange(0.0, self.duration, 1.0 / rate)
-        t = np.append(t, self.duration) if t.size == 0 or t[-1] < self.duration else t
+        t = sample_times(self.duration, rate)
         return (t, *self.at(t))
 
     def peak_ratios(self) -> tuple[float, float]:

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from kcplan.trajectory.curve import BlendedPath
 
-__all__ = ["GRID_INTERVALS", "Trajectory", "time_path"]
+__all__ = ["GRID_INTERVALS", "Trajectory", "sample_times", "time_path"]
 
 GRID_INTERVALS = 40
 """TOPP-RA grid intervals per section of the path (between kinks), spread by length, every
@@ -51,6 +51,21 @@ it: TOPP-RA reads the path's derivatives at a gridpoint from the piece after it,
 interval ending there is constrained by its own piece's, up to a change of order SIDE
 (1e-7 made TOPP-RA's solver lose the constraint on so short an interval; 1e-2 needed a
 0.4 % slow-down; 1e-3 none, and 0.5 % shorter trajectories than without it)."""
+
+
+def sample_times(duration: float, rate: float) -> NDArray[np.float64]:
+    """Seconds ``0, 1 / rate, 2 / rate, ...`` up to ``duration``, which is the last.
+
+    Raises
+    ------
+    ValueError
+        A rate that is not a finite number > 0.
+    """
+    if not (rate > 0 and math.isfinite(rate)):
+        raise ValueError(f"rate: expected a finite number of samples per second > 0, got "
+                         f"{rate!r}")  # fmt: skip
+    t = np.arange(0.0, duration, 1.0 / rate)
+    return np.append(t, duration) if t.size == 0 or t[-1] < duration else t
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,11 +120,7 @@ class Trajectory:
 
     def sample(self, rate: float) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
         """``(t, s, q, qd, qdd)`` every ``1 / rate`` seconds from 0, the end included."""
-        if not (rate > 0 and math.isfinite(rate)):
-            raise ValueError(f"rate: expected a finite number of samples per second > 0, "
-                             f"got {rate!r}")  # fmt: skip
-        t = np.arange(0.0, self.duration, 1.0 / rate)
-        t = np.append(t, self.duration) if t.size == 0 or t[-1] < self.duration else t
+        t = sample_times(self.duration, rate)
         return (t, *self.at(t))
 
     def peak_ratios(self) -> tuple[float, float]:
