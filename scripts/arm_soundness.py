@@ -214,9 +214,9 @@ def held_part(robot: str, shape: str) -> Attached:
             "obstacles": [{shape: PARTS[shape]}]}  # fmt: skip
     if shape == "cylinder":  # the arm scenario's kind: read there
         from kcplan.arm.scenario import _cylinder
-        from kcplan.world.scenario import _Reader
+        from kcplan.world.scenario import FieldReader
 
-        part = _cylinder(_Reader("part"), PARTS[shape], 0)
+        part = _cylinder(FieldReader("part"), PARTS[shape], 0)
     else:
         folder = ROOT / "scenarios" / "arm" / "panda"
         part = parse_scenario(data, "part", folder, check=False).obstacles[0]
