@@ -405,7 +405,9 @@ def plan(
     PlanResult
         ``counters`` holds FCL ``collision_queries`` and ``distance_queries`` (state
         checks and guards together), ``checker_calls``, and for kc planners the
-        validator's counters.
+        validator's counters, among them ``kc_simplify_edges``: the edges OMPL's
+        simplifier asked the certifier (every shortcut and smoothing step is certified
+        like the planner's edges).
     """
     try:
         check_planner_name(planner)
@@ -471,6 +473,7 @@ def plan(
         solve_time = float(ss.getLastPlanComputationTime())
         solved = bool(ss.haveExactSolutionPath())
         simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
+        simplify_edges = 0
         if solved:
             path = ss.getSolutionPath()
             raw_length = float(path.length())
@@ -479,9 +482,11 @@ def plan(
             del path
             if simplify:
                 t0 = time.perf_counter()
+                before = validator.counters["edges"] if validator is not None else 0
                 ss.simplifySolution(float(time_limit))
-                if validator is not None:
+                if validator is not None:  # every edge the simplifier made was certified
                     validator.raise_error()
+                    simplify_edges = validator.counters["edges"] - before
                 path = ss.getSolutionPath()
                 # OMPL's simplifier returns a path whose last check and repair failed with
                 # only a warning ("may slightly touch on an invalid region"): keep the
@@ -499,6 +504,7 @@ def plan(
         }
         if validator is not None:
             counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
+            counters["kc_simplify_edges"] = simplify_edges
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
             from kcplan.planning import trajectory as trajectories
