@@ -21,7 +21,9 @@ smoothing's soundness study).
 It prints (and writes to ``DIR/trajectory_table.md``, rows to ``DIR/rows.json``) per
 class: solved, median planning time, median time to smooth and time (s), median duration
 ratio smoothed / stopping, the largest 1 kHz limit ratios, colliding curves, and the
-corners' blends checked and colliding::
+corners' blends checked and colliding; then one line on OMPL's certified shortcutting
+(the path's length after and before it, the edges it had certified against the
+planner's, its time against solve()'s)::
 
     python scripts/trajectory_bench.py [--robot panda|ur5] [--per-class 20]
         [--classes box,cage] [--time 10] [--seed 1] [--corners 0] [-o DIR]
@@ -110,7 +112,12 @@ def run(args: argparse.Namespace) -> list[dict]:
                 continue
             result = plan(scenario, "kc-rrtconnect", args.time, args.seed, world=world,
                           trajectory=True)  # fmt: skip
-            row |= {"valid": True, "solved": result.solved, "plan_time": result.time}
+            row |= {"valid": True, "solved": result.solved, "plan_time": result.time,
+                    "simplify_time": result.simplify_time, "length": result.length,
+                    "raw_length": result.raw_length,
+                    "simplify_edges": result.counters.get("kc_simplify_edges", 0),
+                    "planner_edges": result.counters.get("kc_edges", 0)
+                    - result.counters.get("kc_simplify_edges", 0)}  # fmt: skip
             if result.solved:
                 timed = result.trajectory
                 t, _, _, qd, qdd = timed.timed.sample(1000.0)
@@ -195,6 +202,15 @@ def main(argv: list[str] | None = None) -> int:
     write_text_atomic(out / "rows.json", json.dumps(rows, indent=1) + "\n")
     write_text_atomic(out / "trajectory_table.md", "\n".join(lines) + "\n")
     print("\n".join(lines))
+    solved = [r for r in rows if r.get("solved")]
+    if solved:  # what OMPL's certified shortcutting bought and cost (RESULTS 14.3)
+        ratio = statistics.median(r["length"] / r["raw_length"] if r["raw_length"] else 1.0
+                                  for r in solved)  # fmt: skip
+        print(f"shortcutting: length after / before {ratio:.2f} (median), "
+              f"{statistics.median(r['simplify_edges'] for r in solved):.0f} certified edges "
+              f"against the planner's {statistics.median(r['planner_edges'] for r in solved):.0f}, "
+              f"{statistics.median(r['simplify_time'] for r in solved) * 1e3:.1f} ms against "
+              f"{statistics.median(r['plan_time'] for r in solved) * 1e3:.1f} ms of solve()")
     bad = sum(r.get("colliding", False) for r in rows) + sum(r.get("corners_colliding", 0)
                                                               for r in rows)  # fmt: skip
     over = [r for r in rows if r.get("solved") and max(r["velocity_1khz"], r["acceleration_1khz"])
