@@ -30,9 +30,15 @@ times larger is free. So the curve itself is certified first, by conservative ad
 t) u1 + t u2)``, so ``|B'_j(t)| <= b_j = 2 delta m_j`` along the whole blend, and the proof
 above holds for the curve with ``b`` in place of ``|dq|`` (the chain's bounds integrate
 ``|dq_j/dt|``, which any curve in the joint box has; :mod:`kcplan.arm.bounds`): a guard at
-``B(t_m)`` proves ``|t - t_m| < r`` free, ``r`` from :func:`stretch_radii` with ``dq = b``.
-The largest blend is tried first, then a quarter of it, and so on, each with at most
-:data:`BLEND_GUARDS` guards, down to the one the corner's guard proves.
+``B(t_m)`` proves ``|t - t_m| < r`` free, ``r`` from :func:`stretch_radii` with ``dq = b``
+(the lever bound too: a lever grows at most at ``sum_i b_i rho[k, i]`` over the joints
+below, whatever the curve). The blends stay in the joint box (the convex hull of ``a``,
+``c``, ``b``, all in it), where ``rho`` holds. The largest blend is tried first, then
+half of it (:data:`BLEND_SHRINK`), and so on, each with at most :data:`BLEND_GUARDS`
+guards, down to the one the corner's guard proves. The compiled certifier advances
+(``ArmCertifier::check_blend``, its guards' clearances capped at what each radius needs);
+this module's advancement (``backend="python"``, every clearance measured) is its twin,
+tested to agree.
 
 Each blend also fits its segments: ``delta <= share * min(|W_i - W_{i-1}|, |W_{i+1} -
 W_i|)``, so two blends never overlap. A guard costs one distance query of every body and
@@ -104,8 +110,8 @@ class BlendCertificate:
 def certify_blends(
     world, waypoints: ArrayLike, share: float = BLEND_SHARE, backend: str = "kernel"
 ) -> BlendCertificate:
-    """The largest blend at each corner of a certified path that one guard proves free
-    (module docstring).
+    """The largest blend at each corner of a certified path that is proved free (module
+    docstring): along its own curve, or, at least, by the guard at its corner.
 
     Parameters
     ----------
@@ -125,6 +131,8 @@ def certify_blends(
     -------
     BlendCertificate
     """
+    if backend not in ("kernel", "python"):
+        raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
     arm = world.arm
     W = np.asarray(waypoints, dtype=float)
     if W.ndim != 2 or W.shape[1] != arm.dof:
@@ -140,8 +148,6 @@ def certify_blends(
     rho, C = point_speeds(arm), carries(arm)
     rho_pairs = relative_speeds(rho, C, pairs)
     only_first, only_second = C[pairs[:, 0]] & ~C[pairs[:, 1]], C[pairs[:, 1]] & ~C[pairs[:, 0]]
-    if backend not in ("kernel", "python"):
-        raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
     kernel = world.kernel
     compiled = ArmCertifier(kernel, first_order=False) if backend == "kernel" else None
     dof = arm.dof
@@ -149,7 +155,8 @@ def certify_blends(
     queries = 0
 
     def radius(q: NDArray, b: NDArray, growth: NDArray) -> tuple[float, float]:
-        """(the radius a guard at q gives a motion of joint speeds b, its clearance)."""
+        """(the radius a guard at q gives a motion of joint speeds at most b, its clearance),
+        ``growth`` the lever growth of b."""
         nonlocal queries
         queries += 1
         scene, pair_d = (np.asarray(x, dtype=float) for x in kernel.safe_clearances(q.tolist()))
@@ -172,21 +179,20 @@ def certify_blends(
         radii[i], clearances[i] = radius(c, m, growth_m)  # the corner's guard: any blend
         delta = caps[i]
         while delta > radii[i]:  # larger blends, certified along their curve
-            b, growth = 2.0 * delta * m, (2.0 * delta) ** 2 * growth_m
-            a_, b_ = c - delta * u1[i], c + delta * u2[i]
+            enter, leave = c - delta * u1[i], c + delta * u2[i]
             if compiled is not None:
-                if compiled.check_blend(a_.tolist(), c.tolist(), b_.tolist(), BLEND_GUARDS):
-                    break
-                delta *= BLEND_SHRINK
-                continue
+                proved = compiled.check_blend(enter.tolist(), c.tolist(), leave.tolist(),
+                                              BLEND_GUARDS)  # fmt: skip
+            else:  # |B'_j(t)| <= speed_j all along the blend (module docstring)
+                speed, growth = 2.0 * delta * m, (2.0 * delta) ** 2 * growth_m
 
-            def reach(t: float, s0: float, s1: float, a_=a_, b_=b_, c=c, b=b, growth=growth):
-                point = (1 - t) ** 2 * a_ + 2 * t * (1 - t) * c + t * t * b_
-                r, _ = radius(point, b, growth)
-                return None if r <= 0.0 else (t - r, t + r)
+                def reach(t, s0, s1, enter=enter, c=c, leave=leave, speed=speed, growth=growth):
+                    point = (1 - t) ** 2 * enter + 2 * t * (1 - t) * c + t * t * leave
+                    r, _ = radius(point, speed, growth)
+                    return None if r <= 0.0 else (t - r, t + r)
 
-            reason, _ = advance(0.0, 1.0, BLEND_GUARDS, reach)
-            if reason is None:
+                proved = advance(0.0, 1.0, BLEND_GUARDS, reach)[0] is None
+            if proved:
                 break
             delta *= BLEND_SHRINK
         blends[i] = min(max(delta, radii[i]), caps[i])
