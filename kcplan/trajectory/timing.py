@@ -112,10 +112,10 @@ class Trajectory:
         dt = t - self.times[i]
         sd = self.speeds[i] + u[i] * dt
         s = np.minimum(self.grid[i] + dt * (self.speeds[i] + 0.5 * u[i] * dt), self.grid[i + 1])
-        # the piece of the interval (right of its start), also at its end
-        piece = np.maximum(s, self.grid[i])
-        d1, d2 = self.path(piece, 1), self.path(piece, 2)
-        d1 = d1 + d2 * (s - piece)[:, None]
+        # the interval's own piece (right of its start), also at its end: dq/ds is linear
+        start = self.grid[i]
+        d2 = self.path(start, 2)
+        d1 = self.path(start, 1) + d2 * (s - start)[:, None]
         return s, self.path(s), d1 * sd[:, None], d2 * (sd**2)[:, None] + d1 * u[i][:, None]
 
     def sample(self, rate: float) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
