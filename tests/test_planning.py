@@ -60,7 +60,12 @@ def test_edge_matches_ompl_interpolation(n):
             assert np.allclose(xi, (s - m) * edge.direction(m), atol=1e-8)
 
 
-@pytest.mark.parametrize("certificates", sorted(CERTIFICATE_SETS))
+# the ball-only ablation (ca) is a study: the other sets run in the ten-minute suite
+@pytest.mark.parametrize(
+    "certificates",
+    [pytest.param(k, marks=pytest.mark.study) if k == "ca" else k
+     for k in sorted(CERTIFICATE_SETS)],  # fmt: skip
+)
 @pytest.mark.parametrize(
     "n, shapes, edges_per_world",
     [(2, [[5, 3.5], [1, 0.4], [3, 3], [8, 1]], 30), (3, [[4, 2.5, 2], [1, 1, 0.3]], 20)],
