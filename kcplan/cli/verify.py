@@ -96,10 +96,7 @@ def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
 
     if args.mesh is not None:
         raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
-    outside = [k for k, q in enumerate(states) if not scenario.arm.within_limits(q)]
-    if outside:
-        raise InputError(f"{args.path}: states[{outside[0]}]: expected joint values within "
-                         "the limits")  # fmt: skip
+    _within_limits(args.path, "states", scenario.arm, states)
     check = verify_arm_path(
         scenario.arm, scenario.obstacles, states, args.tolerance, allowed=scenario.allowed
     )
@@ -139,10 +136,7 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
         file = read_trajectory(data, arm.dof)
     except ValueError as err:
         raise InputError(f"{args.path}: {err}") from None
-    outside = [k for k, q in enumerate(file.path.waypoints) if not arm.within_limits(q)]
-    if outside:
-        raise InputError(f"{args.path}: curve.waypoints[{outside[0]}]: expected joint values "
-                         "within the limits")  # fmt: skip
+    _within_limits(args.path, "curve.waypoints", arm, file.path.waypoints)
     off = file.deviations()
     problems = _sample_problems(off)
     checker = ArmMeshChecker(arm, scenario.obstacles, scenario.allowed, args.tolerance)
@@ -155,6 +149,14 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
     checked = (f"the links' meshes along the whole curve ({pieces} pieces, "
                f"{int((file.path.blends > 0).sum())} blends)")  # fmt: skip
     return _report(problems, checked, check, "distance", len(file.t), off)
+
+
+def _within_limits(path: str, field: str, arm, states) -> None:
+    """One line naming the first of an arm's ``states`` outside its joint limits."""
+    outside = [k for k, q in enumerate(states) if not arm.within_limits(q)]
+    if outside:
+        raise InputError(f"{path}: {field}[{outside[0]}]: expected joint values within the "
+                         "limits")  # fmt: skip
 
 
 def _sample_problems(off: dict) -> list[str]:

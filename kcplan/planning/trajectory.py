@@ -413,16 +413,17 @@ class RigidTrajectoryFile:
         difference in 2D or the chord between the unit quaternions in 3D), ``velocity``
         and ``acceleration`` the largest size of the linear or angular part over its
         limit."""
-        from kcplan.geometry.pose import Edge
+        from kcplan.geometry.pose import Edge, wrap_angle
 
         n, W = self.dimension, self.waypoints
+        edges = [Edge(W[k], W[k + 1], n) for k in range(len(W) - 1)]  # each built once
         k = np.clip(np.floor(self.s).astype(int), 0, len(W) - 2)
         off = 0.0
         for i, (edge_index, q) in enumerate(zip(k, self.q, strict=True)):
-            pose = Edge(W[edge_index], W[edge_index + 1], n).pose(self.s[i] - edge_index)
+            pose = edges[edge_index].pose(self.s[i] - edge_index)
             d = float(np.linalg.norm(pose[:n] - q[:n]))
             if n == 2:
-                d += abs(float(np.angle(np.exp(1j * (pose[2] - q[2])))))
+                d += abs(float(wrap_angle(pose[2] - q[2])))
             else:  # the chord between the quaternions, either sign (robust near 0)
                 d += min(float(np.linalg.norm(pose[3:] - q[3:])),
                          float(np.linalg.norm(pose[3:] + q[3:])))  # fmt: skip
