@@ -18,6 +18,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
       probes_(options.probes),
       part_balls_(options.part_balls),
       first_order_(options.first_order),
+      planes_(options.planes && options.first_order),
       kc_(options.kc_inflation),
       cache_(options.cache_entries),
       rho_(world.chain().point_speeds()),
@@ -114,6 +115,38 @@ double ArmCertifier::kc_reach(const ArmGuard& guard, std::size_t k, Frames& fram
 }
 
 template <class Frames>
+double ArmCertifier::plane_reach(const ArmGuard& guard, std::size_t k, double want,
+                                 Frames& frames) {
+  // the horizon beyond which the ball alone gives `want` (the caps of measure_into)
+  double A, Q;
+  terms(guard, k, A, Q);
+  const double need = std::min({want * speed_[k], want * (A + 0.5 * want * Q),
+                                want * (first_[k] + 0.5 * want * accel_[k])});
+  const double horizon = std::max(kCapSlack * need, kClearanceFloor);
+  if (guard.separated[k] < horizon) {
+    ++plane_queries;
+    if (!world_.body_separations(k, frames(), horizon, guard.separations[k])) {
+      guard.separated[k] = -1.0;
+      return 0.0;  // in contact (the measured clearance said otherwise: trust neither)
+    }
+    guard.separated[k] = horizon;
+  }
+  const double a_max = chain_.bodies()[k].a_max;
+  double t = body_reach(guard, k, guard.separated[k]);  // every obstacle beyond the horizon
+  for (const ArmWorld::Separation& s : guard.separations[k]) {
+    double ts = body_reach(guard, k, s.clearance);
+    if (ts >= t) continue;  // this obstacle cannot lower t
+    if (s.gap > 0.0) {
+      const double across = (std::abs(s.n.dot(u_[k])) + s.n.cross(w_[k]).norm() * a_max) *
+                            (1.0 + 1e-12);  // and rounding
+      ts = std::max(ts, root(s.gap, across, accel_[k]));
+    }
+    t = std::min(t, ts);
+  }
+  return t;
+}
+
+template <class Frames>
 void ArmCertifier::body_radius(const ArmGuard& guard, std::size_t k, double enough, double& r,
                                Frames& frames) {
   // the global speed alone may already give r (reach >= d / v): then nothing here can
@@ -124,7 +157,10 @@ void ArmCertifier::body_radius(const ArmGuard& guard, std::size_t k, double enou
     const double kc = kc_reach(guard, k, frames);
     if (kc > t) ++kc_reaches, t = kc;
   }
-  if (!guard.scene_exact[k] && t < std::min(r, enough)) {
+  if (planes_ && first_order_ && t < std::min(r, enough)) {  // every obstacle's own distance within it too
+    const double p = plane_reach(guard, k, std::min(r, enough), frames);
+    if (p > t) ++plane_reaches, t = p;
+  } else if (!guard.scene_exact[k] && t < std::min(r, enough)) {
     const double cap = std::numeric_limits<double>::infinity();
     guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
     guard.scene_exact[k] = 1;
@@ -297,6 +333,8 @@ void ArmCertifier::measure_into(const double* q, double enough, ArmGuard& g) {
   g.location = world_.location();
   chain_.levers(world_.joint_frames(), frames, g.levers.data());
   g.grown.assign(bodies, 0);
+  g.separated.assign(bodies, -1.0);
+  g.separations.resize(bodies);
   if (first_order_ || kc_ > 0.0) {
     g.joints = world_.joint_frames();
     g.centres.clear();

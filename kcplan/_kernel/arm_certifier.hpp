@@ -41,6 +41,10 @@ struct ArmGuard {
   /// Body k's KC guard (its body grown by 1 + the certifier's kc_inflation about its
   /// centre): 0 not asked yet, 1 certainly clear of the scene, 2 not known to be.
   mutable std::vector<char> grown;
+  /// Body k's separations from the obstacles within `separated[k]` of it (the plane
+  /// certificate), asked on first use; separated[k] < 0: not asked yet.
+  mutable std::vector<std::vector<ArmWorld::Separation>> separations;
+  mutable std::vector<double> separated;
   /// > 0: no body at q is known to touch anything (the scene's smallest bound, and of the
   /// pairs known); set to 0 when a pair is found in contact. A guard whose pairs are not
   /// all known is cached only at an end of an edge, whose radius() is asked at once: a
@@ -67,6 +71,10 @@ struct ArmCertifierOptions {
   /// its body grown by 1 + eps at a guard, proved clear by one query (the class docs); 0:
   /// the clearance ball alone (the `ca` ablation).
   double kc_inflation = 0.0;
+  /// The plane certificate (needs first_order): a body also stays free of an obstacle
+  /// while no point of it moves across the slab between them (the class docs); false:
+  /// the clearance ball alone (the ablation).
+  bool planes = true;
   std::size_t cache_entries = 200000;
 };
 
@@ -169,6 +177,9 @@ class ArmCertifier {
   bool part_balls() const { return part_balls_; }
   bool first_order() const { return first_order_; }
   double kc_inflation() const { return kc_; }
+  bool planes() const { return planes_; }
+  std::int64_t plane_queries = 0;  ///< bodies whose separations were asked
+  std::int64_t plane_reaches = 0;  ///< bodies whose plane reach beat the others' where asked
   double covered_ball = 0.0;  ///< edges certified (each covers its whole [0, 1])
   std::int64_t grown_queries = 0;  ///< KC guards asked (one body query each)
   std::int64_t kc_reaches = 0;     ///< bodies whose KC reach beat their ball's where asked
@@ -189,7 +200,7 @@ class ArmCertifier {
   ArmWorld& world_;
   const Chain& chain_;
   int n_, max_guards_;
-  bool probes_, part_balls_, first_order_;
+  bool probes_, part_balls_, first_order_, planes_;
   double kc_;
   ArmGuardCache cache_;
   /// The radius a clearance d gives to a body or pair of global speed v, lever term A
@@ -203,6 +214,11 @@ class ArmCertifier {
   /// guard's query on first use. Needs twist() of `guard` and the bodies' frames there.
   template <class Frames>
   double kc_reach(const ArmGuard& guard, std::size_t k, Frames& frames);
+  /// Body k's radius by the plane certificate (the class docs), asking its separations
+  /// out to the horizon the ball needs for a radius of `want` if not known that far.
+  /// Needs twist() of `guard` and the bodies' frames there.
+  template <class Frames>
+  double plane_reach(const ArmGuard& guard, std::size_t k, double want, Frames& frames);
   /// Body k's part of radius(): the ball, then (kc) its KC guard, then (a capped
   /// clearance) the clearance measured again, each only while r stays below min(r, enough).
   template <class Frames>

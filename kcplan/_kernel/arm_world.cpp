@@ -201,6 +201,30 @@ double distance_to(const coal::Vec3s& c, const double* centres, int q) {
 
 }  // namespace
 
+bool ArmWorld::body_separations(std::size_t k, const std::vector<coal::Transform3s>& frames,
+                                 double horizon, std::vector<Separation>& out) {
+  out.clear();
+  placed_[k] = 0;  // it leaves the place of the last place()
+  scene_->place_body(k, frames[k]);
+  if (!scene_->body_region(k, horizon, region_)) return false;
+  const ChainBody& body = chain_.bodies()[k];
+  const coal::Vec3s& c = frames[k].getTranslation();
+  for (const Plane& p : region_.planes) {
+    Separation s;
+    s.clearance = p.clearance;
+    s.n = coal::Vec3s(-p.n[0], -p.n[1], -p.n[2]);  // the plane's normal points at the body
+    s.gap = -std::numeric_limits<double>::infinity();
+    if (std::isfinite(p.offset)) {
+      // the obstacle lies in {n . x >= -offset}, the body in {n . x <= n . c + h(n)}
+      const double reach = s.n.dot(c) + half_width(body, frames[k], s.n);
+      const double rounding = 1e-12 * (1.0 + std::abs(p.offset) + c.norm() + body.a_max);
+      s.gap = -p.offset - reach - rounding;
+    }
+    out.push_back(s);
+  }
+  return true;
+}
+
 double ArmWorld::ball_gap(std::size_t m, const std::vector<coal::Transform3s>& frames) const {
   const auto [k, l] = pairs_[m];
   const double a = chain_.bodies()[k].a_max, b = chain_.bodies()[l].a_max;

@@ -102,6 +102,23 @@ class ArmWorld {
     placed_[k] = 0;  // it leaves the place of the last place()
     return scene_->body_safe_clearance(k, frames[k], cap);
   }
+  /// How body k is kept apart from one obstacle near it (body_separations): the body lies
+  /// in {x : n . x <= b} and the obstacle in {x : n . x >= b + gap} for some b, both
+  /// exactly (support functions; `gap` less rounding, <= 0: no slab known), and
+  /// `clearance` is the body's certain distance to the obstacle.
+  struct Separation {
+    coal::Vec3s n;  ///< unit, from the body towards the obstacle
+    double gap;
+    double clearance;
+  };
+  /// The separations of body k at `frames[k]` from every obstacle whose bounding box
+  /// meets the cube of half side a_max,k + horizon about its centre (World::body_region;
+  /// every other obstacle is at least `horizon` away). Along the direction coal's nearest
+  /// points give, the slab is measured by the exact support functions of the body and the
+  /// obstacle, so a wrong direction only narrows it; an obstacle with no support function
+  /// (a mesh) has its clearance only (gap -inf). False, `out` emptied, on contact.
+  bool body_separations(std::size_t k, const std::vector<coal::Transform3s>& frames,
+                        double horizon, std::vector<Separation>& out);
   /// Whether body k at `frames[k]`, grown about its centre by `scale` (semi-axes times
   /// scale >= 1), is certainly clear of the obstacles (World::grown_body_clear; the KC
   /// guard of a body; self pairs are not looked at).
@@ -142,6 +159,7 @@ class ArmWorld {
   std::unique_ptr<World> scene_;
   std::vector<std::shared_ptr<coal::CollisionGeometry>> shapes_;
   std::vector<coal::Transform3s> joints_, frames_, part_frames_;
+  FreeRegion region_;  // body_separations' scratch
   std::vector<double> part_caps_, centres_;
   // per body: the locate() whose frame it has, and whose frame it has in the scene (0:
   // none; body_clearance moves it elsewhere)

@@ -400,16 +400,16 @@ NB_MODULE(_core, m) {
           "__init__",
           [](kcplan::ArmCertifier* self, kcplan::ArmWorld& world, int max_guards,
              std::size_t cache_entries, bool probes, bool part_balls, bool first_order,
-             double kc_inflation) {
+             double kc_inflation, bool planes) {
             kcplan::ArmCertifierOptions o;
             o.max_guards = max_guards, o.cache_entries = cache_entries, o.probes = probes;
             o.part_balls = part_balls, o.first_order = first_order;
-            o.kc_inflation = kc_inflation;
+            o.kc_inflation = kc_inflation, o.planes = planes;
             new (self) kcplan::ArmCertifier(world, o);
           },
           "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
           "part_balls"_a = true, "first_order"_a = true, "kc_inflation"_a = 0.0,
-          nb::keep_alive<1, 2>())
+          "planes"_a = true, nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();
@@ -438,6 +438,8 @@ NB_MODULE(_core, m) {
         d["skipped_groups"] = c.skipped_groups;
         d["grown_queries"] = c.grown_queries;
         d["kc_reaches"] = c.kc_reaches;
+        d["plane_queries"] = c.plane_queries;
+        d["plane_reaches"] = c.plane_reaches;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {
@@ -450,5 +452,6 @@ NB_MODULE(_core, m) {
       .def_prop_ro("probes", &kcplan::ArmCertifier::probes)
       .def_prop_ro("part_balls", &kcplan::ArmCertifier::part_balls)
       .def_prop_ro("first_order", &kcplan::ArmCertifier::first_order)
-      .def_prop_ro("kc_inflation", &kcplan::ArmCertifier::kc_inflation);
+      .def_prop_ro("kc_inflation", &kcplan::ArmCertifier::kc_inflation)
+      .def_prop_ro("planes", &kcplan::ArmCertifier::planes);
 }

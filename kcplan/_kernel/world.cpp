@@ -206,6 +206,12 @@ double World::Support::operator()(const double* n) const {
       }
       return centre[0] * n[0] + centre[1] * n[1] + centre[2] * n[2] + std::sqrt(sq);
     }
+    case kCylinder: {  // c . n + r |n across the axis| + h |n . a|
+      const double along = shape[0] * n[0] + shape[1] * n[1] + shape[2] * n[2];
+      const double across = std::max(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - along * along, 0.0);
+      return centre[0] * n[0] + centre[1] * n[1] + centre[2] * n[2] +
+             radius * std::sqrt(across) + shape[3] * std::abs(along);
+    }
     case kNone:
       break;
   }
@@ -348,8 +354,15 @@ void World::add_cylinder(const std::array<double, 3>& centre,
   require_finite(rotation.data(), 9, "cylinder");
   const double sizes[2] = {radius, half_height};
   require_positive(sizes, 2, "cylinder: expected a positive finite radius and height");
+  Support support;
+  support.kind = Support::kCylinder;
+  support.centre = centre;
+  support.radius = radius;
+  const coal::Matrix3s R = matrix(rotation);
+  for (int i = 0; i < 3; ++i) support.shape[i] = R(i, 2);  // the local z axis
+  support.shape[3] = half_height;
   add(std::make_shared<coal::Cylinder>(radius, 2.0 * half_height),
-      coal::Transform3s(matrix(rotation), vec(centre)), Support{},
+      coal::Transform3s(R, vec(centre)), support,
       Primitive::cylinder(vec(centre), matrix(rotation), radius, half_height));
 }
 
@@ -559,60 +572,75 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
     for (FreeRegion& r : out) r.horizon = std::numeric_limits<double>::infinity();
     return true;
   }
+  for (std::size_t k = 0; k < bodies_.size(); ++k) {
+    FreeRegion& region = out[k];
+    if (!body_region(k, horizon, region)) {
+      for (FreeRegion& r : out) r.planes.clear(), r.horizon = 0.0;
+      return false;
+    }
+    if (region.planes.empty()) {  // open space: the clearance to everything is the better horizon
+      ++counters.distance_queries;
+      region.horizon = std::max(horizon, distance(*bodies_[k], k) * (1.0 - rtol_) - atol_);
+    }
+  }
+  return true;
+}
+
+bool World::body_region(std::size_t k, double horizon, FreeRegion& region) {
+  region.planes.clear();
+  region.horizon = objects_.empty() ? std::numeric_limits<double>::infinity() : horizon;
+  if (objects_.empty()) return true;
+  if (!finalized_) finalize();
+  count_body(k);
+  coal::CollisionObject& body = *bodies_[k];
+  // the broad-phase box of body k: contains every point within `horizon` of the body
+  const double side = 2.0 * (robot_.bodies()[k].a_max + horizon);
+  const double height = dimension_ == 3 ? side : 4.0 * half_height_;  // every prism
+  if (!horizon_boxes_[k]) {
+    horizon_boxes_[k] =
+        std::make_unique<coal::CollisionObject>(std::make_shared<coal::Box>(side, side, height));
+    horizon_sides_[k] = side;
+  } else if (horizon_sides_[k] != side) {  // resized in place: no allocation per query
+    auto* shape = static_cast<coal::Box*>(horizon_boxes_[k]->collisionGeometry().get());
+    shape->halfSide = 0.5 * Vec3s(side, side, height);
+    shape->computeLocalAABB();
+    horizon_sides_[k] = side;
+  }
+  coal::CollisionObject& box = *horizon_boxes_[k];
+  box.setTranslation(body.getTranslation());
+  box.computeAABB();
+  near_.clear();
+  Collect collect;
+  collect.query = &box;
+  collect.found = &near_;
+  manager_->collide(&box, &collect);
+  counters.region_pairs += static_cast<std::int64_t>(near_.size());
   coal::DistanceRequest request = distance_request(/*nearest_points=*/true);
   coal::DistanceResult result;
   const double keep = 1.0 - rtol_;
-  for (std::size_t k = 0; k < bodies_.size(); ++k) {
-    count_body(k);
-    coal::CollisionObject& body = *bodies_[k];
-    // the broad-phase box of body k: contains every point within `horizon` of the body
-    const double side = 2.0 * (robot_.bodies()[k].a_max + horizon);
-    if (horizon_sides_[k] != side) {
-      const double height = dimension_ == 3 ? side : 4.0 * half_height_;  // every prism
-      horizon_boxes_[k] =
-          std::make_unique<coal::CollisionObject>(std::make_shared<coal::Box>(side, side, height));
-      horizon_sides_[k] = side;
+  for (coal::CollisionObject* obstacle : near_) {
+    const double d = pair_distance(body, k, *obstacle, request, result);
+    if (!(d > 0.0)) {
+      region.planes.clear(), region.horizon = 0.0;
+      return false;
     }
-    coal::CollisionObject& box = *horizon_boxes_[k];
-    box.setTranslation(body.getTranslation());
-    box.computeAABB();
-    near_.clear();
-    Collect collect;
-    collect.query = &box;
-    collect.found = &near_;
-    manager_->collide(&box, &collect);
-    counters.region_pairs += static_cast<std::int64_t>(near_.size());
-    FreeRegion& region = out[k];
-    if (near_.empty()) {  // open space: the clearance to everything is the better horizon
-      ++counters.distance_queries;
-      region.horizon = std::max(horizon, distance(body, k) * keep - atol_);
-      continue;
+    Plane plane;
+    plane.clearance = std::max(d * keep - atol_, 0.0);
+    const Support& support = supports_[reinterpret_cast<std::size_t>(obstacle->getUserData())];
+    double v[3] = {0.0, 0.0, 0.0};
+    if (support.kind != Support::kNone) {  // a mesh's distance may come without points
+      const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];
+      v[0] = dir[0], v[1] = dir[1], v[2] = dimension_ == 3 ? dir[2] : 0.0;
     }
-    for (coal::CollisionObject* obstacle : near_) {
-      const double d = pair_distance(body, k, *obstacle, request, result);
-      if (!(d > 0.0)) {
-        for (FreeRegion& r : out) r.planes.clear(), r.horizon = 0.0;
-        return false;
-      }
-      Plane plane;
-      plane.clearance = std::max(d * keep - atol_, 0.0);
-      const Support& support =
-          supports_[reinterpret_cast<std::size_t>(obstacle->getUserData())];
-      double v[3] = {0.0, 0.0, 0.0};
-      if (support.kind != Support::kNone) {  // a mesh's distance may come without points
-        const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];
-        v[0] = dir[0], v[1] = dir[1], v[2] = dimension_ == 3 ? dir[2] : 0.0;
-      }
-      const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      if (support.kind == Support::kNone || !(length > 0.0) || !std::isfinite(length)) {
-        plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
-        plane.offset = std::numeric_limits<double>::infinity();
-      } else {
-        for (int i = 0; i < 3; ++i) plane.n[i] = v[i] / length;
-        plane.offset = support(plane.n);  // exact: a wrong direction only weakens the plane
-      }
-      region.planes.push_back(plane);
+    const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (support.kind == Support::kNone || !(length > 0.0) || !std::isfinite(length)) {
+      plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
+      plane.offset = std::numeric_limits<double>::infinity();
+    } else {
+      for (int i = 0; i < 3; ++i) plane.n[i] = v[i] / length;
+      plane.offset = support(plane.n);  // exact: a wrong direction only weakens the plane
     }
+    region.planes.push_back(plane);
   }
   return true;
 }

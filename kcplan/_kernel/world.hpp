@@ -124,6 +124,12 @@ class World {
   /// as horizon. Returns false, with every region empty and of horizon 0, as soon as a
   /// piece touches a body.
   bool free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out);
+  /// One body's part of free_regions, for body k as placed: `out` gets the plane and
+  /// clearance of every piece whose bounding box meets the cube of half side max(a_k) +
+  /// horizon about the body's centre, and `horizon` (an empty region: nothing within
+  /// it). Returns false, `out` emptied with horizon 0, when a piece touches the body.
+  /// Counted as a body query.
+  bool body_region(std::size_t k, double horizon, FreeRegion& out);
   // -- the same queries for bodies placed one by one (an arm: each body by its own frame) --
   /// Make body k the convex `shape` instead of its ellipsoid (in the body's frame, inside
   /// the ellipsoid: a link's hull, ChainBody::hull). Such a body has no KC guard:
@@ -179,11 +185,12 @@ class World {
  private:
   /// The exact support function h(n) = max over the piece of n . x, for region planes.
   struct Support {
-    enum Kind { kPoints, kBall, kEllipsoid, kNone } kind = kNone;
+    enum Kind { kPoints, kBall, kEllipsoid, kCylinder, kNone } kind = kNone;
     std::vector<double> points;  // kPoints: m x 3
     std::array<double, 3> centre{};
     double radius = 0.0;
-    std::array<double, 9> shape{};  // kEllipsoid: diag(e) R^T, row-major
+    /// kEllipsoid: diag(e) R^T, row-major; kCylinder: its unit axis, then its half height
+    std::array<double, 9> shape{};
     double operator()(const double* n) const;
   };
 

@@ -246,6 +246,46 @@ class ArmWorld:
                 scene[k] = min(scene[k], self._distance(k, supports[k], self._objects[i], piece))
         return scene, self._pair_clearances(supports)
 
+    def separations(self, state: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
+        """How each body at ``state`` is kept apart from each obstacle piece: ``normals``
+        ``(bodies, pieces, 3)``, unit directions from the body towards the piece (FCL's
+        nearest points), ``gaps`` ``(bodies, pieces)``, the separation of the two exact
+        support functions along them (the body lies in ``{n . x <= b}``, the piece in
+        ``{n . x >= b + gap}``; ``-inf`` for a mesh piece or a degenerate direction, 0 on
+        contact) and ``clearances`` ``(bodies, pieces)``, certain distances as
+        :meth:`safe_clearances` measures them. These are the slabs of the plane
+        certificate (:mod:`kcplan.planning.arm_certifier`; the kernel's
+        ``ArmWorld::body_separations``). One distance query: every body against every
+        piece."""
+        supports = self._place(state)
+        self._fcl_counters["distance_queries"] += 1
+        shape = (len(self._bodies), len(self._objects))
+        normals, gaps = np.zeros(shape + (3,)), np.full(shape, -math.inf)
+        clearances = np.zeros(shape)
+        for k, obj in enumerate(self._bodies):
+            for i, (piece, support) in enumerate(zip(self._objects, self._supports, strict=True)):
+                result = fcl.DistanceResult()
+                d = fcl.distance(obj, piece, self._request, result)
+                if d <= 0.0:
+                    gaps[k, i] = 0.0
+                    continue
+                if support is None:  # a mesh: FCL's distance alone
+                    clearances[k, i] = d
+                    continue
+                if result.o1 is self._shapes[k]:
+                    p_a, p_b = result.nearest_points
+                else:  # FCL swaps some pairs (and their points)
+                    p_b, p_a = result.nearest_points
+                direction = np.asarray(p_b, dtype=float) - np.asarray(p_a, dtype=float)
+                length = math.sqrt(float(direction @ direction))
+                if length == 0.0:
+                    gaps[k, i] = 0.0
+                    continue
+                normals[k, i] = direction / length
+                gaps[k, i] = separation(supports[k], support, normals[k, i])
+                clearances[k, i] = max(gaps[k, i], 0.0)
+        return normals, gaps, self._safe(clearances)
+
     def grown_clear(self, state: ArrayLike, scale: float) -> NDArray[np.bool_]:
         """Whether each body at ``state``, grown about its centre by ``scale`` (semi-axes
         times ``scale >= 1``), is certainly clear of the obstacles, ``(bodies,)``: its

@@ -62,6 +62,22 @@ Moving along its long axes (``|diag(a)^-1 R_g^T u|`` small) a body may go much f
 than its clearance. Self pairs keep the ball. A KC guard is asked only where the ball
 leaves a body short, and cached with its guard.
 
+*The plane certificate* (``planes``, with ``first_order``) is a third proof of a body's
+clearance to the scene, for bodies that slide past a surface. At a guard body ``k`` and an
+obstacle piece lie on either side of a slab of width ``g`` across a unit ``n``
+(:meth:`kcplan.arm.ArmWorld.separations`: the body in ``{n . x <= b}``, the piece in ``{n .
+x >= b + g}``, from the exact support functions along FCL's direction). A point ``x`` of
+the body moves along ``n`` at ``n . (u + w x (x - c)) = n . u + (x - c) . (n x w)`` at the
+guard, at most ``|n . u| + |n x w| a_max`` (``|x - c| <= a_max``), and its acceleration is
+at most ``M`` (as above), so within ``t`` of the guard it crosses at most ``(|n . u| + |n x
+w| a_max) t + M t^2 / 2`` of the slab, and the body stays on its side, free of the piece,
+while that is below ``g``. A body's radius is then the smallest over the pieces of the
+larger of this root and the ball's reach of the body's distance to that piece alone. The
+hand moving over a table (``n`` vertical, its twist mostly horizontal) so goes much
+farther than its clearance. The kernel measures the slabs of the pieces within the
+horizon the ball needs (every other piece gives at least what is needed), the twin those
+of every piece; the radii differ only where both are at least what is needed.
+
 With ``kc_inflation = 0`` this is the ``ca`` certificate of arms (the rigid robots'
 clearance ball with the chain's speeds). The module imports neither OMPL nor FCL (the
 world does the queries).
@@ -93,6 +109,7 @@ from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
 from kcplan.planning.guard import GuardCache
 
 __all__ = [
+    "ARM_CERTIFICATES",
     "ARM_COUNTER_NAMES",
     "DEFAULT_KC_INFLATION",
     "MAX_PROBES",
@@ -117,6 +134,10 @@ PROBE_STEP = 0.1
 ``ArmCertifier::kProbeStep``. OMPL's default discrete check of the Panda steps 0.134."""
 MAX_PROBES = 64
 """Probes per edge at most (``ArmCertifier::kMaxProbes``)."""
+ARM_CERTIFICATES = ("ball", "kc", "region")
+"""The certificates of arms, all used by default: the chain's clearance balls (always),
+the KC guards (``kc_inflation > 0``) and the free-region planes (``planes``; module
+docstring). A certifier's ``certificates`` names those it uses, in this order."""
 DEFAULT_KC_INFLATION = 0.2
 """The KC guard's inflation ``eps`` of the ``kc-*`` planners on arms (a scenario's
 ``robot.inflation`` overrides it): each body grown by 1.2 about its centre."""
@@ -135,6 +156,7 @@ class ArmGuard:
     levers: np.ndarray
     state: np.ndarray
     grown: np.ndarray | None = None
+    separations: tuple | None = None  # ArmWorld.separations at the state (planes)
 
     @property
     def clearance(self) -> float:
@@ -171,6 +193,9 @@ class ArmEdgeCertifier:
     kc_inflation : float
         The KC certificate's ``eps`` (module docstring); 0: the clearance ball alone
         (the ``ca`` ablation).
+    planes : bool
+        The plane certificate (module docstring; with ``first_order`` only); False: the
+        ablation.
     """
 
     backend = "python"
@@ -183,13 +208,15 @@ class ArmEdgeCertifier:
         probes: bool = True,
         first_order: bool = True,
         kc_inflation: float = 0.0,
+        planes: bool = True,
     ):
         if not (math.isfinite(kc_inflation) and kc_inflation >= 0.0):
             raise ValueError(f"kc_inflation: expected a finite number >= 0, got {kc_inflation!r}")
         self.kc_inflation = float(kc_inflation)
-        self.certificates = ("ball", "kc") if self.kc_inflation > 0 else ("ball",)
         self.world, self.arm = world, world.arm
         self.probes, self.first_order = bool(probes), bool(first_order)
+        self.planes = bool(planes) and self.first_order
+        self.certificates = arm_certificates(self.kc_inflation, self.planes)
         self.n = self.arm.dof
         self.max_guards = int(max_guards)
         self._rho = point_speeds(self.arm)
@@ -232,7 +259,8 @@ class ArmEdgeCertifier:
         if self.kc_inflation > 0:
             self.counters["collision_queries"] += 1
             grown = self.world.grown_clear(q, 1.0 + self.kc_inflation)
-        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q), q, grown)
+        separations = self.world.separations(q) if self.planes else None
+        return ArmGuard(*self.world.safe_clearances(q), levers(self.arm, q), q, grown, separations)
 
     def _endpoint(self, q: np.ndarray) -> ArmGuard:
         key = q.tobytes()
@@ -276,6 +304,11 @@ class ArmEdgeCertifier:
             if self.first_order:
                 twist = (twist_speeds(self.arm, w, velocity), accel)
         bodies = stretch_radii(guard.scene, speed, L @ dq, growth, twist)
+        if guard.separations is not None:
+            planes = _plane_reaches(
+                guard.separations, a.max(axis=1), w, velocity, speed, L @ dq, growth, *twist
+            )
+            bodies = np.fmax(bodies, planes)
         if guard.grown is not None:
             rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
             kc = _kc_reaches(
@@ -362,6 +395,13 @@ class ArmEdgeCertifier:
         return True
 
 
+def arm_certificates(kc_inflation: float, planes: bool) -> tuple[str, ...]:
+    """The names (:data:`ARM_CERTIFICATES`) of the certificates a certifier with this KC
+    inflation and planes uses."""
+    used = {"ball": True, "kc": kc_inflation > 0, "region": planes}
+    return tuple(name for name in ARM_CERTIFICATES if used[name])
+
+
 def _length(dq: np.ndarray) -> float:
     """``|dq|`` summed in order, as the kernel sums it (the probe count is its floor)."""
     return math.sqrt(sum(float(d) * float(d) for d in dq))
@@ -413,6 +453,39 @@ def _kc_reaches(
             nu = np.linalg.norm(local, axis=1)
             t = np.fmax(t, _root(eps, nu + spin / a_min, M / a_min))
     return np.where(grown, t, 0.0)
+
+
+def _plane_reaches(
+    separations: tuple,
+    a_max: np.ndarray,
+    w: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    A: np.ndarray,
+    Q: np.ndarray,
+    A1: np.ndarray,
+    M: np.ndarray,
+) -> np.ndarray:
+    """The radius each body's slabs give it (module docstring, the plane certificate),
+    shape ``(bodies,)``: over the pieces, the smallest of the larger of the ball's reach of
+    the distance to that piece and the root of ``(|n . u| + |n x w| a_max) t + M t^2 / 2 =
+    gap``. ``separations`` is :meth:`kcplan.arm.ArmWorld.separations` at the guard, ``w``
+    and ``u`` the bodies' twists there ``(bodies, 3)``, ``v, A, Q`` and ``(A1, M)`` as for
+    :func:`stretch_radii` ``(bodies,)``."""
+    normals, gaps, clearances = separations
+    bodies, pieces = gaps.shape
+    if pieces == 0:
+        return np.full(bodies, math.inf)
+    ball = stretch_radii(
+        clearances.ravel(), np.repeat(v, pieces), np.repeat(A, pieces), np.repeat(Q, pieces),
+        (np.repeat(A1, pieces), np.repeat(M, pieces)),
+    ).reshape(bodies, pieces)  # fmt: skip
+    across = np.abs(np.einsum("kpi,ki->kp", normals, u))
+    across += np.linalg.norm(np.cross(normals, w[:, None, :]), axis=2) * a_max[:, None]
+    across *= 1.0 + 1e-12  # and rounding
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slab = np.where(gaps > 0, _root(np.maximum(gaps, 0.0), across, M[:, None]), 0.0)
+    return np.fmax(ball, slab).min(axis=1)
 
 
 def _root(d: np.ndarray, A: np.ndarray, Q: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from kcplan._kernel import ArmCertifier as _CompiledArmCertifier
 from kcplan._kernel import EdgeCertifier as _CompiledCertifier
+from kcplan.planning.arm_certifier import arm_certificates
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
 from kcplan.planning.ladder import GuardLadder
 
@@ -164,6 +165,10 @@ class KernelArmCertifier:
     kc_inflation : float
         The KC certificate's ``eps`` (:mod:`kcplan.planning.arm_certifier`); 0: the
         clearance ball alone (the ``ca`` ablation).
+    planes : bool
+        The plane certificate (with ``first_order``; :mod:`kcplan.planning.arm_certifier`):
+        a body stays free of an obstacle while it does not cross the slab between them.
+        False is the ablation.
 
     Notes
     -----
@@ -171,7 +176,9 @@ class KernelArmCertifier:
     guard's radius, so that coal measured their distance), ``refined_bodies``,
     ``skipped_groups`` (groups of pairs a radius decided by their links' balls),
     ``grown_queries`` (KC guards asked) and ``kc_reaches`` (bodies whose KC guard took them
-    farther than their ball where a radius asked). Not thread-safe.
+    farther than their ball where a radius asked), ``plane_queries`` (bodies whose
+    separations from the obstacles near them were asked) and ``plane_reaches`` (bodies the
+    plane certificate took farther than the ball). Not thread-safe.
     """
 
     backend = "kernel"
@@ -186,14 +193,15 @@ class KernelArmCertifier:
         part_balls: bool = True,
         first_order: bool = True,
         kc_inflation: float = 0.0,
+        planes: bool = True,
     ):
         self.world = world
         self.n = world.arm.dof
         self.compiled = _CompiledArmCertifier(
             world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls),
-            bool(first_order), float(kc_inflation),
+            bool(first_order), float(kc_inflation), bool(planes),
         )  # fmt: skip
-        self.certificates = ("ball", "kc") if kc_inflation > 0 else ("ball",)
+        self.certificates = arm_certificates(kc_inflation, self.compiled.planes)
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have

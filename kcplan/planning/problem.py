@@ -20,6 +20,7 @@ from ompl import util as ou
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.arm.world import ArmWorld
+from kcplan.planning.arm_certifier import ARM_CERTIFICATES
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import (
     ARM_RANGE,
@@ -84,13 +85,17 @@ class PlannerSpec:
 
 
 _KC, _CA, _PAPER = CERTIFICATE_SETS["kc"], CERTIFICATE_SETS["ca"], CERTIFICATE_SETS["kc-paper"]
+_ARM_CERTIFICATES = {_CA: ("ball",), _PAPER: ("ball", "kc")}
+"""What a rigid planner's certificates are on an arm (any other set: every arm certificate,
+:data:`kcplan.planning.arm_certifier.ARM_CERTIFICATES`): ``ca-*`` the clearance balls alone,
+``kc-*-paper`` the paper's KC guards beside them, without the free-region planes."""
 PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
         _KC,
         description="stock RRT-Connect, edges certified by free-region planes (exact); "
         "OMPL's default range (0.2 x the space's maximum extent); arms: the chain's "
-        "clearance balls and the KC guards, range ARM_RANGE",
+        "clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
@@ -105,7 +110,8 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect-paper": PlannerSpec(
         og.RRTConnect,
         _PAPER,
-        description="ablation: kc-rrtconnect with the paper's KC polytope only",
+        description="ablation: kc-rrtconnect with the paper's KC polytope only (arms: the "
+        "clearance balls and the KC guards, without the free-region planes)",
     ),
     "kc-prm-paper": PlannerSpec(
         og.PRM, _PAPER, description="ablation: kc-prm with the paper's KC polytope only"
@@ -616,9 +622,8 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     validator = None
     n = arm.dof
     if spec.kc:
-        ball_only = spec.certificates == CERTIFICATE_SETS["ca"]
         validator = KCMotionValidator(
-            si, arm, world, certificates=("ball",) if ball_only else ("ball", "kc"),
+            si, arm, world, certificates=_ARM_CERTIFICATES.get(spec.certificates, ARM_CERTIFICATES),
             inflations=[scenario.inflation] if scenario.inflation > 0 else None,
             backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls,
             first_order=spec.first_order,

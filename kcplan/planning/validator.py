@@ -41,7 +41,11 @@ from ompl import base as ob
 
 from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
-from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
+from kcplan.planning.arm_certifier import (
+    ARM_CERTIFICATES,
+    DEFAULT_KC_INFLATION,
+    ArmEdgeCertifier,
+)
 from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
 from kcplan.planning.ladder import GuardLadder
@@ -70,8 +74,9 @@ class KCMotionValidator(ob.MotionValidator):
     certificates : sequence of str, optional
         Default ``("region",)``, or ``("rotation",)`` when the world has no
         ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`. For an
-        arm ``("ball", "kc")`` (the default: the chain's clearance balls and the KC
-        guards of :mod:`kcplan.planning.arm_certifier`) or ``("ball",)``.
+        arm ``("ball", "kc", "region")`` (the default: the chain's clearance balls, the
+        KC guards and the free-region planes of :mod:`kcplan.planning.arm_certifier`), or
+        ``("ball",)`` with any of ``"kc"`` and ``"region"``.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
@@ -185,14 +190,21 @@ class KCMotionValidator(ob.MotionValidator):
         backend = "kernel" if backend is None else backend
         if backend not in ("kernel", "python"):
             raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
-        chosen = None if certificates is None else tuple(certificates)
-        if chosen not in (None, ("ball",), ("ball", "kc")) or fallback != "bisection":
+        chosen = ARM_CERTIFICATES if certificates is None else tuple(certificates)
+        if (
+            not chosen
+            or chosen[0] != "ball"
+            or not set(chosen[1:]) <= {"kc", "region"}
+            or len(set(chosen)) != len(chosen)
+            or fallback != "bisection"
+        ):
             raise ValueError(
-                "certificates: arms have ('ball', 'kc') (the default) and ('ball',), with "
-                f"bisection; got {certificates!r} with {fallback!r}"
+                "certificates: arms have ('ball', 'kc', 'region') (the default), or ('ball',) "
+                f"with any of 'kc' and 'region', with bisection; got {certificates!r} with "
+                f"{fallback!r}"
             )
-        kc_inflation = 0.0
-        if chosen != ("ball",):
+        kc_inflation, planes = 0.0, "region" in chosen
+        if "kc" in chosen:
             kc_inflation = DEFAULT_KC_INFLATION if not inflations else float(inflations[0])
             if not (math.isfinite(kc_inflation) and kc_inflation > 0.0):
                 raise ValueError(f"inflations: expected a KC inflation > 0, got {inflations!r}")
@@ -200,7 +212,7 @@ class KCMotionValidator(ob.MotionValidator):
         if backend == "kernel":
             self.certifier = KernelArmCertifier(
                 world, max_guards, probes=probes > 0, part_balls=part_balls,
-                first_order=first_order, kc_inflation=kc_inflation,
+                first_order=first_order, kc_inflation=kc_inflation, planes=planes,
             )  # fmt: skip
             # the hot path: one call into the kernel with the joint vector(s)
             self.state_valid = self._valid_kernel_arm
@@ -208,7 +220,7 @@ class KCMotionValidator(ob.MotionValidator):
         else:
             self.certifier = ArmEdgeCertifier(
                 world, max_guards, probes=probes > 0, first_order=first_order,
-                kc_inflation=kc_inflation,
+                kc_inflation=kc_inflation, planes=planes,
             )  # fmt: skip
         self.backend = backend
         self.n = arm.dof
