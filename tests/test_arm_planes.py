@@ -77,11 +77,11 @@ def test_a_hand_sliding_over_a_table_needs_few_guards(panda):
     world = ArmWorld(panda, round_table(TABLE_TOP))
     q1, q2 = yaw_edge()
     assert not world.in_collision(q1) and not world.in_collision(q2)
-    planes, ball = KernelArmCertifier(world), KernelArmCertifier(world, planes=False)
+    planes, ball = KernelArmCertifier(world, planes=True), KernelArmCertifier(world)
     assert planes.check(q1, q2) and ball.check(q1, q2)
     assert planes.counters["plane_reaches"] > 0 and ball.counters["plane_queries"] == 0
     assert 3 * planes.counters["guards"] <= ball.counters["guards"]
-    twin = ArmEdgeCertifier(world)
+    twin = ArmEdgeCertifier(world, planes=True)
     assert twin.check(q1, q2)
     assert abs(twin.counters["guards"] - planes.counters["guards"]) <= 1
     check = verify_arm_path(panda, world.obstacles, [q1, q2])
@@ -98,6 +98,28 @@ def test_a_table_in_the_hands_way_rejects_the_edge(panda, raise_by):
     assert not world.in_collision(q1) and not world.in_collision(q2)
     assert world.in_collision(READY)  # the middle of the edge
     assert verify_arm_path(panda, world.obstacles, [q1, q2]).collides
-    for certifier in (KernelArmCertifier(world), ArmEdgeCertifier(world)):
+    for kind in (KernelArmCertifier, ArmEdgeCertifier):
+        certifier = kind(world, planes=True)
+        assert certifier.planes
         assert not certifier.check(q1, q2)
         assert certifier.counters["rejected"] == 1
+
+
+def test_planes_decide_random_edges_as_the_twin_and_soundly(panda, world, states):
+    """Random edges in the arm tests' scene with the planes on: the kernel and its Python
+    twin decide alike (coal's and FCL's directions differ a little), the planes take some
+    bodies farther than their balls, and every accepted edge is free on the meshes."""
+    free = [q for q in states if not world.in_collision(q)]
+    kernel, twin = KernelArmCertifier(world, planes=True), ArmEdgeCertifier(world, planes=True)
+    rng = np.random.default_rng(3)
+    same = accepted = 0
+    for _ in range(40):
+        q1, q2 = free[rng.integers(len(free))], free[rng.integers(len(free))]
+        q2 = q1 + rng.uniform(0.05, 0.5) * (q2 - q1)
+        ok = kernel.check(q1, q2)
+        same += ok == twin.check(q1, q2)
+        if ok:
+            accepted += 1
+            assert not verify_arm_path(panda, world.obstacles, [q1, q2]).collides, (q1, q2)
+    assert same >= 38 and accepted >= 10
+    assert kernel.counters["plane_reaches"] > 0

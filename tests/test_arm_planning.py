@@ -177,25 +177,28 @@ def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
 
 
 def test_the_validator_chooses_the_arm_certificates(panda, scene):
-    """An arm's validator certifies with the clearance ball, the KC guards and the
-    free-region planes by default (kc-*), with the ball alone for certificates=("ball",)
-    (ca-*), the ball and either of the others when asked; anything else, or an inflation
-    that is not a positive number, is one clear ValueError."""
+    """An arm's validator certifies with the clearance ball and the KC guards by default
+    (kc-*), with the ball alone for certificates=("ball",) (ca-*), the ball and any of the
+    KC guards and the free-region planes when asked; anything else, or an inflation that
+    is not a positive number, is one clear ValueError."""
     world, _ = scene
     si = ob.SpaceInformation(joint_space(panda.lower, panda.upper))
     default = KCMotionValidator(si, panda, world)
-    assert default.certifier.certificates == ("ball", "kc", "region")
+    assert default.certifier.certificates == ("ball", "kc")
     assert default.certifier.compiled.kc_inflation == DEFAULT_KC_INFLATION
-    assert default.certifier.compiled.planes
+    assert not default.certifier.compiled.planes
     ball = KCMotionValidator(si, panda, world, certificates=("ball",))
     assert ball.certifier.certificates == ("ball",) and ball.certifier.compiled.kc_inflation == 0
     assert not ball.certifier.compiled.planes
     planes = KCMotionValidator(si, panda, world, certificates=("ball", "region"))
     assert planes.certifier.certificates == ("ball", "region")
-    python = KCMotionValidator(si, panda, world, backend="python", inflations=[0.3])
+    python = KCMotionValidator(
+        si, panda, world, backend="python", inflations=[0.3], certificates=("ball", "kc", "region")
+    )
     assert python.certifier.kc_inflation == 0.3 and python.certifier.planes
     for bad in (("region",), ("ball", "polytope"), ("ball", "kc", "kc"), ()):
-        with pytest.raises(ValueError, match=r"certificates: arms have \('ball', 'kc', 'region'\)"):
+        expected = r"certificates: arms have \('ball', 'kc', 'region'\): 'ball', then"
+        with pytest.raises(ValueError, match=expected):
             KCMotionValidator(si, panda, world, certificates=bad)
     for bad in ([0.0], [-1.0], [float("nan")]):
         with pytest.raises(ValueError, match="inflations: expected a KC inflation > 0"):

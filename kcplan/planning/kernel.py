@@ -168,7 +168,7 @@ class KernelArmCertifier:
     planes : bool
         The plane certificate (with ``first_order``; :mod:`kcplan.planning.arm_certifier`):
         a body stays free of an obstacle while it does not cross the slab between them.
-        False is the ablation.
+        Off by default (:data:`kcplan.planning.arm_certifier.DEFAULT_ARM_CERTIFICATES`).
 
     Notes
     -----
@@ -193,7 +193,7 @@ class KernelArmCertifier:
         part_balls: bool = True,
         first_order: bool = True,
         kc_inflation: float = 0.0,
-        planes: bool = True,
+        planes: bool = False,
     ):
         self.world = world
         self.n = world.arm.dof
@@ -201,7 +201,8 @@ class KernelArmCertifier:
             world.kernel, int(max_guards), int(cache_entries), bool(probes), bool(part_balls),
             bool(first_order), float(kc_inflation), bool(planes),
         )  # fmt: skip
-        self.certificates = arm_certificates(kc_inflation, self.compiled.planes)
+        self.planes = self.compiled.planes
+        self.certificates = arm_certificates(kc_inflation, self.planes)
 
     def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have

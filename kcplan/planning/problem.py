@@ -20,7 +20,7 @@ from ompl import util as ou
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.arm.world import ArmWorld
-from kcplan.planning.arm_certifier import ARM_CERTIFICATES
+from kcplan.planning.arm_certifier import DEFAULT_ARM_CERTIFICATES
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import (
     ARM_RANGE,
@@ -76,6 +76,7 @@ class PlannerSpec:
     joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
     part_balls: bool = True  # arms (kc, kernel): far groups of self pairs decided at once
     first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
+    arm_certificates: tuple[str, ...] | None = None  # arms (kc): the validator's, if not by kind
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
 
     @property
@@ -85,17 +86,17 @@ class PlannerSpec:
 
 
 _KC, _CA, _PAPER = CERTIFICATE_SETS["kc"], CERTIFICATE_SETS["ca"], CERTIFICATE_SETS["kc-paper"]
-_ARM_CERTIFICATES = {_CA: ("ball",), _PAPER: ("ball", "kc")}
-"""What a rigid planner's certificates are on an arm (any other set: every arm certificate,
-:data:`kcplan.planning.arm_certifier.ARM_CERTIFICATES`): ``ca-*`` the clearance balls alone,
-``kc-*-paper`` the paper's KC guards beside them, without the free-region planes."""
+_ARM_CERTIFICATES = {_CA: ("ball",)}
+"""What a planner's certificates are on an arm when it names none (``arm_certificates``;
+any other set: :data:`kcplan.planning.arm_certifier.DEFAULT_ARM_CERTIFICATES`): ``ca-*``
+the clearance balls alone."""
 PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
         _KC,
         description="stock RRT-Connect, edges certified by free-region planes (exact); "
         "OMPL's default range (0.2 x the space's maximum extent); arms: the chain's "
-        "clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
+        "clearance balls and the KC guards, range ARM_RANGE",
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
@@ -110,8 +111,7 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect-paper": PlannerSpec(
         og.RRTConnect,
         _PAPER,
-        description="ablation: kc-rrtconnect with the paper's KC polytope only (arms: the "
-        "clearance balls and the KC guards, without the free-region planes)",
+        description="ablation: kc-rrtconnect with the paper's KC polytope only",
     ),
     "kc-prm-paper": PlannerSpec(
         og.PRM, _PAPER, description="ablation: kc-prm with the paper's KC polytope only"
@@ -150,6 +150,14 @@ PLANNERS: dict[str, PlannerSpec] = {
         "pair, without the links' balls that decide far groups of pairs at once (the "
         "world's state checks, every planner's, use those balls either way)",
         part_balls=False,
+    ),
+    "kc-rrtconnect-planes": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="arms: kc-rrtconnect with the free-region planes as well (a link stays "
+        "free of an obstacle while it does not cross the slab between them; rigid robots: as "
+        "kc-rrtconnect)",
+        arm_certificates=("ball", "kc", "region"),
     ),
     "kc-rrtconnect-nofirst": PlannerSpec(
         og.RRTConnect,
@@ -623,7 +631,8 @@ def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
     n = arm.dof
     if spec.kc:
         validator = KCMotionValidator(
-            si, arm, world, certificates=_ARM_CERTIFICATES.get(spec.certificates, ARM_CERTIFICATES),
+            si, arm, world, certificates=spec.arm_certificates
+            or _ARM_CERTIFICATES.get(spec.certificates, DEFAULT_ARM_CERTIFICATES),
             inflations=[scenario.inflation] if scenario.inflation > 0 else None,
             backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls,
             first_order=spec.first_order,

@@ -43,6 +43,7 @@ from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
 from kcplan.planning.arm_certifier import (
     ARM_CERTIFICATES,
+    DEFAULT_ARM_CERTIFICATES,
     DEFAULT_KC_INFLATION,
     ArmEdgeCertifier,
 )
@@ -74,9 +75,9 @@ class KCMotionValidator(ob.MotionValidator):
     certificates : sequence of str, optional
         Default ``("region",)``, or ``("rotation",)`` when the world has no
         ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`. For an
-        arm ``("ball", "kc", "region")`` (the default: the chain's clearance balls, the
-        KC guards and the free-region planes of :mod:`kcplan.planning.arm_certifier`), or
-        ``("ball",)`` with any of ``"kc"`` and ``"region"``.
+        arm ``("ball", "kc")`` (the default: the chain's clearance balls and the KC
+        guards of :mod:`kcplan.planning.arm_certifier`), or ``("ball",)`` with any of
+        ``"kc"`` and ``"region"`` (its free-region planes).
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
@@ -190,7 +191,7 @@ class KCMotionValidator(ob.MotionValidator):
         backend = "kernel" if backend is None else backend
         if backend not in ("kernel", "python"):
             raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
-        chosen = ARM_CERTIFICATES if certificates is None else tuple(certificates)
+        chosen = DEFAULT_ARM_CERTIFICATES if certificates is None else tuple(certificates)
         if (
             not chosen
             or chosen[0] != "ball"
@@ -199,9 +200,9 @@ class KCMotionValidator(ob.MotionValidator):
             or fallback != "bisection"
         ):
             raise ValueError(
-                "certificates: arms have ('ball', 'kc', 'region') (the default), or ('ball',) "
-                f"with any of 'kc' and 'region', with bisection; got {certificates!r} with "
-                f"{fallback!r}"
+                f"certificates: arms have {ARM_CERTIFICATES}: 'ball', then any of the others "
+                f"(default {DEFAULT_ARM_CERTIFICATES}), with bisection; got {certificates!r} "
+                f"with {fallback!r}"
             )
         kc_inflation, planes = 0.0, "region" in chosen
         if "kc" in chosen:
