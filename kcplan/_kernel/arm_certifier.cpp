@@ -58,6 +58,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   accel_.resize(speed_.size());
   first_.resize(speed_.size());
   turn_.resize(speed_.size());
+  body_t_.resize(speed_.size());
 }
 
 double ArmCertifier::root(double d, double A, double Q) {
@@ -157,10 +158,7 @@ void ArmCertifier::body_radius(const ArmGuard& guard, std::size_t k, double enou
     const double kc = kc_reach(guard, k, frames);
     if (kc > t) ++kc_reaches, t = kc;
   }
-  if (planes_ && first_order_ && t < std::min(r, enough)) {  // every obstacle's own distance within it too
-    const double p = plane_reach(guard, k, std::min(r, enough), frames);
-    if (p > t) ++plane_reaches, t = p;
-  } else if (!guard.scene_exact[k] && t < std::min(r, enough)) {
+  if (!guard.scene_exact[k] && t < std::min(r, enough)) {
     const double cap = std::numeric_limits<double>::infinity();
     guard.scene[k] = std::max(guard.scene[k], world_.body_clearance(k, frames(), cap));
     guard.scene_exact[k] = 1;
@@ -394,25 +392,68 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
     }
     return *at;
   };
-  // the measured clearances first; then a capped one that would hold r below what is
-  // needed is refined (after the KC guard): the radius is then that of exact distances
-  // (and KC guards), or at least `enough`
-  for (int exact = 1; exact >= 0; --exact)
-    for (std::size_t k = 0; k < bodies; ++k)
-      if (speed_[k] > 0.0 && guard.scene_exact[k] == exact) body_radius(guard, k, enough, r, frames);
+  constexpr double kOpen = 1.0 - 1e-9;  // the open stretch, with a margin for rounding
+  if (!(planes_ && first_order_)) {
+    // the measured clearances first; then a capped one that would hold r below what is
+    // needed is refined (after the KC guard): the radius is then that of exact distances
+    // (and KC guards), or at least `enough`
+    for (int exact = 1; exact >= 0; --exact)
+      for (std::size_t k = 0; k < bodies; ++k)
+        if (speed_[k] > 0.0 && guard.scene_exact[k] == exact)
+          body_radius(guard, k, enough, r, frames);
+    return pairs_radius(guard, enough, r, frames) * kOpen;
+  }
+  // With the planes, which cost a region query of the body, a body's planes are asked
+  // only where they may raise the radius: the balls (and KC guards) of all bodies and the
+  // pairs first (a pair below every body's ball decides it), then the planes of the body
+  // that limits, in turn, until one whose planes were measured as far as needed limits
+  // it, then the pairs again (a pair the balls' radius left out may limit the new one).
+  // Every term is the one of exact distances where it is below `enough` (the class docs),
+  // so is the radius.
+  std::vector<double>& t = body_t_;
+  for (std::size_t k = 0; k < bodies; ++k) {
+    t[k] = std::numeric_limits<double>::infinity();
+    if (!(speed_[k] > 0.0)) continue;
+    t[k] = body_reach(guard, k, guard.scene[k]);
+    if (kc_ > 0.0 && t[k] < enough) t[k] = std::max(t[k], kc_reach(guard, k, frames));
+  }
+  double least = *std::min_element(t.begin(), t.end());
+  const double balls = pairs_radius(guard, enough, least, frames);
+  if (balls < least || !(least < enough)) return balls * kOpen;
+  // each body's planes as far as `enough` needs, once: then it limits where it is least
+  for (std::size_t round = 0; round < bodies; ++round) {
+    const std::size_t arg = std::min_element(t.begin(), t.end()) - t.begin();
+    least = t[arg];
+    if (!(least < enough)) break;
+    const double p = plane_reach(guard, arg, enough, frames);
+    if (!(p > least)) break;  // its planes add nothing: it limits
+    ++plane_reaches;
+    t[arg] = p;
+    if (p < enough) {  // it may still limit: the others are asked only while below it
+      bool below = false;
+      for (std::size_t k = 0; k < bodies; ++k) below = below || (k != arg && t[k] < p);
+      if (!below) break;
+    }
+  }
+  return pairs_radius(guard, enough, *std::min_element(t.begin(), t.end()), frames) * kOpen;
+}
+
+template <class Frames>
+double ArmCertifier::pairs_radius(const ArmGuard& guard, double enough, double r,
+                                  Frames& frames) {
   if (!part_balls_) {
     const double unknown = std::numeric_limits<double>::infinity();  // no bound but v
     for (std::size_t m = 0; m < pair_speed_.size(); ++m)
       pair_radius(guard, m, enough, r, frames, unknown);
-    return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
+    return r;
   }
   // a group whose gap gives its pairs at least r cannot lower r (the class docs)
   std::fill(group_t_.begin(), group_t_.end(), -1.0);
   for (const ArmWorld::Run& run : world_.runs()) {
     if (!(r > 0.0)) return 0.0;
-    double& t = group_t_[run.group];
-    if (t < 0.0) t = group_reach(guard, run.group);
-    if (t >= r) {
+    double& g = group_t_[run.group];
+    if (g < 0.0) g = group_reach(guard, run.group);
+    if (g >= r) {
       ++skipped_groups;
       continue;
     }
@@ -420,7 +461,7 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
     if (run_reach(guard, run, frames, v) >= r) continue;  // the body against the other part
     for (std::size_t m = run.begin; m < run.end; ++m) pair_radius(guard, m, enough, r, frames, v);
   }
-  return r * (1.0 - 1e-9);  // the open stretch, with a margin for rounding
+  return r;
 }
 
 std::shared_ptr<const ArmGuard> ArmCertifier::endpoint(const double* q,

@@ -247,6 +247,10 @@ class ArmCertifier {
   template <class Frames>
   void pair_radius(const ArmGuard& guard, std::size_t m, double enough, double& r,
                    Frames& frames, double bound);
+  /// The self pairs' part of radius(): r lowered to what every pair allows (pair_radius,
+  /// whole groups and runs decided at once with part_balls).
+  template <class Frames>
+  double pairs_radius(const ArmGuard& guard, double enough, double r, Frames& frames);
 
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
@@ -268,6 +272,7 @@ class ArmCertifier {
   std::vector<coal::Transform3s> joints_, frames_;  // scratch of refinements
   std::vector<std::pair<double, double>> pending_;
   ArmGuard scratch_;  // the advancement's guards, measured in place
+  std::vector<double> body_t_;  // radius() with the planes: each body's reach so far
 };
 
 }  // namespace kcplan

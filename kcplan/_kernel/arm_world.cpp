@@ -206,7 +206,7 @@ bool ArmWorld::body_separations(std::size_t k, const std::vector<coal::Transform
   out.clear();
   placed_[k] = 0;  // it leaves the place of the last place()
   scene_->place_body(k, frames[k]);
-  if (!scene_->body_region(k, horizon, region_)) return false;
+  if (!scene_->body_region(k, horizon, region_, /*primitive_slabs=*/true)) return false;
   const ChainBody& body = chain_.bodies()[k];
   const coal::Vec3s& c = frames[k].getTranslation();
   for (const Plane& p : region_.planes) {

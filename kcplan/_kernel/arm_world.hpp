@@ -113,10 +113,12 @@ class ArmWorld {
   };
   /// The separations of body k at `frames[k]` from every obstacle whose bounding box
   /// meets the cube of half side a_max,k + horizon about its centre (World::body_region;
-  /// every other obstacle is at least `horizon` away). Along the direction coal's nearest
-  /// points give, the slab is measured by the exact support functions of the body and the
-  /// obstacle, so a wrong direction only narrows it; an obstacle with no support function
-  /// (a mesh) has its clearance only (gap -inf). False, `out` emptied, on contact.
+  /// every other obstacle is at least `horizon` away). A box, ball or cylinder is taken
+  /// along the line from its point nearest the body's centre when that holds them apart
+  /// (Primitive::separation, no GJK), any other obstacle along coal's nearest points; the
+  /// slab is measured by the exact support functions of the body and the obstacle, so a
+  /// wrong direction only narrows it. An obstacle with no support function (a mesh) has
+  /// its clearance only (gap -inf). False, `out` emptied, on contact.
   bool body_separations(std::size_t k, const std::vector<coal::Transform3s>& frames,
                         double horizon, std::vector<Separation>& out);
   /// Whether body k at `frames[k]`, grown about its centre by `scale` (semi-axes times

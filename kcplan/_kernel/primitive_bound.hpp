@@ -89,6 +89,12 @@ struct Primitive {
   /// docs; <= 0: nothing known, e.g. the shape's centre inside the obstacle, or no
   /// primitive). `exact` is set when the bound is the distance itself (a ball outside).
   double separation(const ShapeSupport& shape, bool& exact) const {
+    coal::Vec3s n;
+    return separation(shape, exact, n);
+  }
+  /// separation(), and `n` the unit direction it is measured along (from the obstacle
+  /// towards the shape's centre; the shape lies in {x : n . x >= support(n) + the bound}).
+  double separation(const ShapeSupport& shape, bool& exact, coal::Vec3s& n) const {
     exact = false;
     constexpr double kUnknown = -std::numeric_limits<double>::infinity();
     if (kind == kNone) return kUnknown;
@@ -96,7 +102,7 @@ struct Primitive {
     const coal::Vec3s d = c - nearest(c);
     const double length = d.norm();
     if (!(length > 0.0) || !std::isfinite(length)) return kUnknown;
-    const coal::Vec3s n = d / length;
+    n = d / length;
     const double gap = n.dot(c) - shape.spread(-n) - support(n);
     const double scale = 1.0 + c.norm() + centre.norm() + size.norm() + shape.spread_high;
     exact = !shape.capsule && shape.spread_low == shape.spread_high;

@@ -586,7 +586,7 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
   return true;
 }
 
-bool World::body_region(std::size_t k, double horizon, FreeRegion& region) {
+bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool primitive_slabs) {
   region.planes.clear();
   region.horizon = objects_.empty() ? std::numeric_limits<double>::infinity() : horizon;
   if (objects_.empty()) return true;
@@ -618,7 +618,23 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region) {
   coal::DistanceRequest request = distance_request(/*nearest_points=*/true);
   coal::DistanceResult result;
   const double keep = 1.0 - rtol_;
+  ShapeSupport shape;
+  primitive_slabs = primitive_slabs && ShapeSupport::of(body, shape);
   for (coal::CollisionObject* obstacle : near_) {
+    const std::size_t index = reinterpret_cast<std::size_t>(obstacle->getUserData());
+    if (primitive_slabs && primitives_[index].kind != Primitive::kNone) {
+      bool exact;
+      Vec3s n;
+      const double gap = primitives_[index].separation(shape, exact, n);
+      if (gap > 0.0) {  // the obstacle lies in {n . x <= support(n)}, the body beyond it
+        Plane plane;
+        for (int i = 0; i < 3; ++i) plane.n[i] = n[i];
+        plane.offset = primitives_[index].support(n);
+        plane.clearance = gap;
+        region.planes.push_back(plane);
+        continue;
+      }
+    }
     const double d = pair_distance(body, k, *obstacle, request, result);
     if (!(d > 0.0)) {
       region.planes.clear(), region.horizon = 0.0;
@@ -626,7 +642,7 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region) {
     }
     Plane plane;
     plane.clearance = std::max(d * keep - atol_, 0.0);
-    const Support& support = supports_[reinterpret_cast<std::size_t>(obstacle->getUserData())];
+    const Support& support = supports_[index];
     double v[3] = {0.0, 0.0, 0.0};
     if (support.kind != Support::kNone) {  // a mesh's distance may come without points
       const Vec3s dir = result.nearest_points[0] - result.nearest_points[1];

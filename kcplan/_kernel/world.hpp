@@ -128,8 +128,11 @@ class World {
   /// clearance of every piece whose bounding box meets the cube of half side max(a_k) +
   /// horizon about the body's centre, and `horizon` (an empty region: nothing within
   /// it). Returns false, `out` emptied with horizon 0, when a piece touches the body.
-  /// Counted as a body query.
-  bool body_region(std::size_t k, double horizon, FreeRegion& out);
+  /// With `primitive_slabs`, a box, ball or cylinder piece that Primitive::separation
+  /// already holds apart from the body gets that plane (along the line from its point
+  /// nearest the body's centre, clearance the separation) with no GJK. Counted as a body
+  /// query.
+  bool body_region(std::size_t k, double horizon, FreeRegion& out, bool primitive_slabs = false);
   // -- the same queries for bodies placed one by one (an arm: each body by its own frame) --
   /// Make body k the convex `shape` instead of its ellipsoid (in the body's frame, inside
   /// the ellipsoid: a link's hull, ChainBody::hull). Such a body has no KC guard:

@@ -106,7 +106,7 @@ class ArmWorld:
         and that are not proven apart."""
         self._shapes = [_fcl_shape(b) for b in arm.bodies]
         self._bodies = [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
-        self._objects, self._supports, boxes = [], [], []
+        self._objects, self._supports, self._nearest, boxes = [], [], [], []
         for ob in self.obstacles:
             if len(ob.center) != 3:
                 raise ValueError(f"{ob.label}: expected a 3D obstacle for an arm")
@@ -114,6 +114,7 @@ class ArmWorld:
             for (geometry, tf), support in zip(parts, piece_supports(ob), strict=True):
                 self._objects.append(fcl.CollisionObject(geometry, tf))
                 self._supports.append(support)
+                self._nearest.append(_nearest_point(ob) if len(parts) == 1 else None)
                 boxes.append(_box(ob, support))
         self._boxes = np.array(boxes).reshape(-1, 2, 3)
         self._manager = fcl.DynamicAABBTreeCollisionManager()
@@ -166,7 +167,7 @@ class ArmWorld:
     def _place(self, state: ArrayLike) -> list:
         """Place the bodies at ``state``; their support functions there."""
         supports = []
-        frames = body_frames(self.arm, self._joints(state))
+        frames = self._frames = body_frames(self.arm, self._joints(state))
         for obj, frame, body in zip(self._bodies, frames, self.arm.bodies, strict=True):
             obj.setTransform(fcl.Transform(frame[:3, :3], frame[:3, 3]))
             supports.append(_support(body, frame))
@@ -253,8 +254,10 @@ class ArmWorld:
         support functions along them (the body lies in ``{n . x <= b}``, the piece in
         ``{n . x >= b + gap}``; ``-inf`` for a mesh piece or a degenerate direction, 0 on
         contact) and ``clearances`` ``(bodies, pieces)``, certain distances as
-        :meth:`safe_clearances` measures them. These are the slabs of the plane
-        certificate (:mod:`kcplan.planning.arm_certifier`; the kernel's
+        :meth:`safe_clearances` measures them. A box, ball or cylinder is taken along the
+        line from its point nearest the body's centre where the two are apart along it
+        (its clearance then that separation), as the kernel takes it. These are the slabs
+        of the plane certificate (:mod:`kcplan.planning.arm_certifier`; the kernel's
         ``ArmWorld::body_separations``). One distance query: every body against every
         piece."""
         supports = self._place(state)
@@ -262,8 +265,18 @@ class ArmWorld:
         shape = (len(self._bodies), len(self._objects))
         normals, gaps = np.zeros(shape + (3,)), np.full(shape, -math.inf)
         clearances = np.zeros(shape)
+        exact = np.zeros(shape, dtype=bool)  # a primitive's separation: no allowance
         for k, obj in enumerate(self._bodies):
+            centre = self._frames[k][:3, 3]
             for i, (piece, support) in enumerate(zip(self._objects, self._supports, strict=True)):
+                if self._nearest[i] is not None:
+                    line = self._nearest[i](centre) - centre  # from the body towards the piece
+                    length = math.sqrt(float(line @ line))
+                    gap = separation(supports[k], support, line / length) if length > 0 else 0.0
+                    if gap > 0.0:
+                        normals[k, i], gaps[k, i], clearances[k, i] = line / length, gap, gap
+                        exact[k, i] = True
+                        continue
                 result = fcl.DistanceResult()
                 d = fcl.distance(obj, piece, self._request, result)
                 if d <= 0.0:
@@ -284,7 +297,7 @@ class ArmWorld:
                 normals[k, i] = direction / length
                 gaps[k, i] = separation(supports[k], support, normals[k, i])
                 clearances[k, i] = max(gaps[k, i], 0.0)
-        return normals, gaps, self._safe(clearances)
+        return normals, gaps, np.where(exact, clearances, self._safe(clearances))
 
     def grown_clear(self, state: ArrayLike, scale: float) -> NDArray[np.bool_]:
         """Whether each body at ``state``, grown about its centre by ``scale`` (semi-axes
@@ -355,6 +368,31 @@ class ArmWorld:
 
     def _safe(self, d: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.maximum(d * (1.0 - CLEARANCE_RTOL) - self.clearance_atol, 0.0)
+
+
+def _nearest_point(obstacle: Obstacle):
+    """The point of a box, ball or cylinder obstacle nearest a point ``x`` (``x`` itself
+    inside), as a function of ``x`` ``(3,)``; None for any other kind (the kernel's
+    ``Primitive::nearest``)."""
+    c, R, e = obstacle.center, obstacle.rotation, obstacle.extents
+    if obstacle.kind == "box":
+        return lambda x: c + R @ np.clip(R.T @ (x - c), -e, e)
+    if obstacle.kind == "sphere":
+        def ball(x):
+            d = x - c
+            r = math.sqrt(float(d @ d))
+            return x if r <= e[0] else c + d * (e[0] / r)
+        return ball
+    if obstacle.kind == "cylinder":  # extents (r, r, h / 2) about the local z axis
+        def cylinder(x):
+            local = R.T @ (x - c)
+            r = math.hypot(local[0], local[1])
+            if r > e[0]:
+                local[:2] *= e[0] / r
+            local[2] = min(max(local[2], -e[2]), e[2])
+            return c + R @ local
+        return cylinder
+    return None
 
 
 def _fcl_shape(body):
