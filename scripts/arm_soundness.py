@@ -25,7 +25,7 @@ stderr; a Markdown table on stdout::
     python scripts/arm_soundness.py [--robot panda] [--edges 100000] [--seed 1]
         [--per-class 100] [--representation R] [--bodies 2] [--max-offset D] [--twin 0]
         [--free-check 0.05]
-        [--kc-inflation 0.2]
+        [--kc-inflation 0.2] [--planes]
 
 The arm's links are each their own convex hull with ``--representation hulls`` (kcplan's
 default), else covered by ``--bodies`` ellipsoids each (2 by default: fast to fit
@@ -109,7 +109,7 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
     c = {"edges": 0, "accepted": 0, "violations": 0, "verified": 0, "twin": 0,
          "twin_accepted": 0, "twin_violations": 0, "twin_disagree": 0,
          "decide_s": 0.0, "verify_s": 0.0, "twin_s": 0.0, "grown_queries": 0,
-         "kc_reaches": 0}  # fmt: skip
+         "kc_reaches": 0, "plane_reaches": 0}  # fmt: skip
     steps = {name: {"rejected": 0, "checked": 0, "free": 0} for name in STEPS}
     per_problem = math.ceil(args.edges / len(chosen))
     start = time.perf_counter()
@@ -117,18 +117,20 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
         if k % per_problem == 0:
             problem = chosen[(k // per_problem) % len(chosen)]
             world = ArmWorld(arm, problem.obstacles, allowed=problem.allowed)
-            kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation)
+            kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation, planes=args.planes)
             meshes = ArmMeshChecker(arm, problem.obstacles, problem.allowed)
             twin = None
             if k < args.twin:
-                twin = ArmEdgeCertifier(world, kc_inflation=args.kc_inflation)
+                twin = ArmEdgeCertifier(
+                    world, kc_inflation=args.kc_inflation, planes=args.planes
+                )
         q1, q2 = _edge(rng, arm, kernel)
         before = dict(kernel.counters)
         t = time.perf_counter()
         ok = kernel.check(q1, q2)
         c["decide_s"] += time.perf_counter() - t
         c["edges"] += 1
-        for name in ("grown_queries", "kc_reaches"):  # what the KC guards did
+        for name in ("grown_queries", "kc_reaches", "plane_reaches"):  # what they did
             c[name] += kernel.counters[name] - before[name]
         verdict = None
         verified = functools.partial(_collides, meshes, q1, q2, c)
@@ -249,6 +251,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="fraction of rejected edges verified on the meshes")  # fmt: skip
     parser.add_argument("--kc-inflation", type=float, default=DEFAULT_KC_INFLATION,
                         help="the KC guards' inflation (0: the clearance balls alone)")  # fmt: skip
+    parser.add_argument("--planes", action="store_true",
+                        help="certify with the free-region planes as well")  # fmt: skip
     parser.add_argument("--mbm", default=os.fspath(MBM), help="folder of the MBM robots")
     args = parser.parse_args(argv)
     if args.bodies is None and args.max_offset is None and args.representation != "hulls":
@@ -282,6 +286,7 @@ def main(argv: list[str] | None = None) -> int:
         f"- {r['problems']} problems ({args.per_class} per class), {r['arm'].describe()}, "
         f"seed {args.seed}; KC inflation {args.kc_inflation}: {c['grown_queries']} KC guards "
         f"asked, {c['kc_reaches']} took a body farther than its ball"
+        + (f"; planes: {c['plane_reaches']} took a body farther" if args.planes else "")
     )
     print(f"- wall {c['wall_s']:.0f} s; kernel {1e6 * c['decide_s'] / c['edges']:.0f} us per "
           f"edge; mesh verification {verify_per:.1f} ms per edge ({c['verified']} verified)"

@@ -151,8 +151,14 @@ CASES = [
     ),
     Case(  # on hulls, holding a part between the fingers
         "arm_soundness.py",
-        ("--edges", "8", "--per-class", "1", "--representation", "hulls", "--attach", "cylinder"),
-        (r"^\| panda \| kernel \| 8 \| \d+ \| 0 \| ", r"arm of 7 joints, 12 bodies"),
+        ("--edges", "8", "--per-class", "1", "--representation", "hulls", "--attach", "cylinder")
+        + ("--planes", "--twin", "3"),
+        (
+            r"^\| panda \| kernel \| 8 \| \d+ \| 0 \| ",
+            r"^\| panda \| python \| 3 \| \d+ \| 0 \| ",
+            r"arm of 7 joints, 12 bodies",
+            r"; planes: \d+ took a body farther$",
+        ),
     ),
     Case(
         "edge_outcomes.py",
