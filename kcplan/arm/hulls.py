@@ -50,7 +50,7 @@ __all__ = [
     "points_hull",
 ]
 
-HULL_VERSION = 1
+HULL_VERSION = 2
 """Bumped whenever :func:`hull_pieces` would compute other hulls: the cache's key has it."""
 
 MAX_PIECES = 4
@@ -132,8 +132,18 @@ def points_hull(
     except Exception:  # qhull inside it, on a nearly flat hull: any interior centre serves
         centre = np.asarray(hull.vertices, dtype=float).mean(axis=0)
     vertices = hull.vertices - centre
-    normals = hull.face_normals
-    heights = np.einsum("ij,ij->i", normals, vertices[hull.faces[:, 0]])
+    # the faces' planes from their own corners: trimesh merges points closer than its
+    # tolerance, which can leave triangles with a repeated corner (no face) and report
+    # the normal of a thin face rounded (a merged point outside its true plane would
+    # pass); the proof below needs the true planes of the faces that remain
+    faces = np.asarray(hull.faces, dtype=np.int64)
+    faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
+                  & (faces[:, 0] != faces[:, 2])]  # fmt: skip
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    normals = np.cross(b - a, c - a)
+    lengths = np.linalg.norm(normals, axis=1)
+    faces, normals = faces[lengths > 0], normals[lengths > 0] / lengths[lengths > 0, None]
+    heights = np.einsum("ij,ij->i", normals, vertices[faces[:, 0]])
     delta = float(slack)  # in blocks: 130,000 vertices against 8,000 faces at once is 8 GB
     block = max(1, 4_000_000 // len(normals))
     for start in range(0, len(points), block):
@@ -146,9 +156,7 @@ def points_hull(
             raise ValueError("expected points that span a volume, got a degenerate hull")
         vertices = inner + (vertices - inner) * (1.0 + 2.0 * delta / rho)  # 2: its rounding
     radius = float(np.linalg.norm(vertices, axis=1).max()) * (1.0 + 1e-12)
-    hull_out = BodyHull(
-        np.ascontiguousarray(vertices), np.asarray(hull.faces, dtype=np.int64), radius, delta
-    )
+    hull_out = BodyHull(np.ascontiguousarray(vertices), faces, radius, delta)
     return centre, hull_out
 
 
