@@ -25,7 +25,7 @@ stderr; a Markdown table on stdout::
     python scripts/arm_soundness.py [--robot panda] [--edges 100000] [--seed 1]
         [--per-class 100] [--representation R] [--bodies 2] [--max-offset D] [--twin 0]
         [--free-check 0.05]
-        [--kc-inflation 0.2] [--planes]
+        [--kc-inflation 0.2] [--no-planes]
 
 The arm's links are each their own convex hull with ``--representation hulls`` (kcplan's
 default), else covered by ``--bodies`` ellipsoids each (2 by default: fast to fit
@@ -251,8 +251,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="fraction of rejected edges verified on the meshes")  # fmt: skip
     parser.add_argument("--kc-inflation", type=float, default=DEFAULT_KC_INFLATION,
                         help="the KC guards' inflation (0: the clearance balls alone)")  # fmt: skip
-    parser.add_argument("--planes", action="store_true",
-                        help="certify with the free-region planes as well")  # fmt: skip
+    parser.add_argument("--no-planes", dest="planes", action="store_false",
+                        help="certify without the free-region planes (the ablation)")  # fmt: skip
     parser.add_argument("--mbm", default=os.fspath(MBM), help="folder of the MBM robots")
     args = parser.parse_args(argv)
     if args.bodies is None and args.max_offset is None and args.representation != "hulls":
@@ -286,7 +286,7 @@ def main(argv: list[str] | None = None) -> int:
         f"- {r['problems']} problems ({args.per_class} per class), {r['arm'].describe()}, "
         f"seed {args.seed}; KC inflation {args.kc_inflation}: {c['grown_queries']} KC guards "
         f"asked, {c['kc_reaches']} took a body farther than its ball"
-        + (f"; planes: {c['plane_reaches']} took a body farther" if args.planes else "")
+        + (f"; planes: {c['plane_reaches']} took a body farther" if args.planes else "; no planes")
     )
     print(f"- wall {c['wall_s']:.0f} s; kernel {1e6 * c['decide_s'] / c['edges']:.0f} us per "
           f"edge; mesh verification {verify_per:.1f} ms per edge ({c['verified']} verified)"

@@ -157,7 +157,7 @@ def test_kernel_kc_decides_as_the_python_kc(world, free):
     assert k["kc_reaches"] > 0 and k["grown_queries"] > 0
     assert k["guards"] <= b["guards"] and b["grown_queries"] == 0
     assert abs(k["guards"] - p["guards"]) <= max(3, 0.05 * p["guards"])
-    assert kernel.certificates == python.certificates == ("ball", "kc")
+    assert kernel.certificates == python.certificates == ("ball", "kc", "region")
 
 
 def test_bad_kc_inflations_are_refused(world):

@@ -177,21 +177,23 @@ def test_rrtconnect_plans_a_certified_arm_path(panda, scene):
 
 
 def test_the_validator_chooses_the_arm_certificates(panda, scene):
-    """An arm's validator certifies with the clearance ball and the KC guards by default
-    (kc-*), with the ball alone for certificates=("ball",) (ca-*), the ball and any of the
-    KC guards and the free-region planes when asked; anything else, or an inflation that
-    is not a positive number, is one clear ValueError."""
+    """An arm's validator certifies with the clearance ball, the KC guards and the
+    free-region planes by default (kc-*), with the ball alone for certificates=("ball",)
+    (ca-*), the ball and either of the others when asked; anything else, or an inflation
+    that is not a positive number, is one clear ValueError."""
     world, _ = scene
     si = ob.SpaceInformation(joint_space(panda.lower, panda.upper))
     default = KCMotionValidator(si, panda, world)
-    assert default.certifier.certificates == ("ball", "kc")
+    assert default.certifier.certificates == ("ball", "kc", "region")
     assert default.certifier.compiled.kc_inflation == DEFAULT_KC_INFLATION
-    assert not default.certifier.compiled.planes
+    assert default.certifier.compiled.planes
     ball = KCMotionValidator(si, panda, world, certificates=("ball",))
     assert ball.certifier.certificates == ("ball",) and ball.certifier.compiled.kc_inflation == 0
     assert not ball.certifier.compiled.planes
     planes = KCMotionValidator(si, panda, world, certificates=("ball", "region"))
     assert planes.certifier.certificates == ("ball", "region")
+    without = KCMotionValidator(si, panda, world, certificates=("ball", "kc"))
+    assert without.certifier.certificates == ("ball", "kc") and not without.certifier.planes
     python = KCMotionValidator(
         si, panda, world, backend="python", inflations=[0.3], certificates=("ball", "kc", "region")
     )

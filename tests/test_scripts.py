@@ -145,14 +145,15 @@ CASES = [
             r"^\| robot \| backend \| edges \| accepted \| violations \| rejected: end state ",
             r"^\| panda \| kernel \| 14 \| \d+ \| 0 \| \d+ / \d+ / \d+ / \d+ \| ",
             r"^\| panda \| python \| 4 \| \d+ \| 0 \| ",
-            r"KC inflation 0.2: \d+ KC guards asked, \d+ took a body farther than its ball$",
+            r"KC inflation 0.2: \d+ KC guards asked, \d+ took a body farther than its ball; "
+            r"planes: \d+ took a body farther$",
             rf"mesh verification {NUMBER} ms per edge",
         ),
     ),
     Case(  # on hulls, holding a part between the fingers
         "arm_soundness.py",
         ("--edges", "8", "--per-class", "1", "--representation", "hulls", "--attach", "cylinder")
-        + ("--planes", "--twin", "3"),
+        + ("--twin", "3"),
         (
             r"^\| panda \| kernel \| 8 \| \d+ \| 0 \| ",
             r"^\| panda \| python \| 3 \| \d+ \| 0 \| ",

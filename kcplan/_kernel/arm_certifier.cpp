@@ -415,7 +415,10 @@ double ArmCertifier::radius(const ArmGuard& guard, double enough) {
     t[k] = std::numeric_limits<double>::infinity();
     if (!(speed_[k] > 0.0)) continue;
     t[k] = body_reach(guard, k, guard.scene[k]);
-    if (kc_ > 0.0 && t[k] < enough) t[k] = std::max(t[k], kc_reach(guard, k, frames));
+    if (kc_ > 0.0 && t[k] < enough) {
+      const double kc = kc_reach(guard, k, frames);
+      if (kc > t[k]) ++kc_reaches, t[k] = kc;
+    }
   }
   double least = *std::min_element(t.begin(), t.end());
   const double balls = pairs_radius(guard, enough, least, frames);

@@ -73,9 +73,8 @@ struct ArmCertifierOptions {
   double kc_inflation = 0.0;
   /// The plane certificate (needs first_order): a body also stays free of an obstacle
   /// while no point of it moves across the slab between them (the class docs); false:
-  /// the others alone (the default: on MBM's problems the planes cost more than the
-  /// guards they save, benchmarks/RESULTS.md 15.1).
-  bool planes = false;
+  /// the others alone (the ablation).
+  bool planes = true;
   std::size_t cache_entries = 200000;
 };
 

@@ -409,7 +409,7 @@ NB_MODULE(_core, m) {
           },
           "world"_a, "max_guards"_a = 256, "cache_entries"_a = 200000, "probes"_a = true,
           "part_balls"_a = true, "first_order"_a = true, "kc_inflation"_a = 0.0,
-          "planes"_a = false, nb::keep_alive<1, 2>())
+          "planes"_a = true, nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                        const std::vector<double>& q2) {
         const kcplan::Chain& chain = c.world().chain();

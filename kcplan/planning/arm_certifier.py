@@ -139,9 +139,9 @@ ARM_CERTIFICATES = ("ball", "kc", "region")
 """The certificates of arms: the chain's clearance balls (always), the KC guards
 (``kc_inflation > 0``) and the free-region planes (``planes``; module docstring). A
 certifier's ``certificates`` names those it uses, in this order."""
-DEFAULT_ARM_CERTIFICATES = ("ball", "kc")
-"""What the ``kc-*`` planners use on arms: the planes are left out, since on MBM's Panda
-problems they cost more than the guards they save (``benchmarks/RESULTS.md``, 15.1)."""
+DEFAULT_ARM_CERTIFICATES = ARM_CERTIFICATES
+"""What the ``kc-*`` planners use on arms: all of them (the planes make the Panda's MBM
+problems 0.89x the time without them, ``benchmarks/RESULTS.md`` 15.1)."""
 DEFAULT_KC_INFLATION = 0.2
 """The KC guard's inflation ``eps`` of the ``kc-*`` planners on arms (a scenario's
 ``robot.inflation`` overrides it): each body grown by 1.2 about its centre."""
@@ -198,8 +198,8 @@ class ArmEdgeCertifier:
         The KC certificate's ``eps`` (module docstring); 0: the clearance ball alone
         (the ``ca`` ablation).
     planes : bool
-        The plane certificate (module docstring; with ``first_order`` only); off by
-        default (:data:`DEFAULT_ARM_CERTIFICATES`).
+        The plane certificate (module docstring; with ``first_order`` only); False is
+        the ablation.
     """
 
     backend = "python"
@@ -212,7 +212,7 @@ class ArmEdgeCertifier:
         probes: bool = True,
         first_order: bool = True,
         kc_inflation: float = 0.0,
-        planes: bool = False,
+        planes: bool = True,
     ):
         if not (math.isfinite(kc_inflation) and kc_inflation >= 0.0):
             raise ValueError(f"kc_inflation: expected a finite number >= 0, got {kc_inflation!r}")

@@ -168,7 +168,7 @@ class KernelArmCertifier:
     planes : bool
         The plane certificate (with ``first_order``; :mod:`kcplan.planning.arm_certifier`):
         a body stays free of an obstacle while it does not cross the slab between them.
-        Off by default (:data:`kcplan.planning.arm_certifier.DEFAULT_ARM_CERTIFICATES`).
+        False is the ablation.
 
     Notes
     -----
@@ -193,7 +193,7 @@ class KernelArmCertifier:
         part_balls: bool = True,
         first_order: bool = True,
         kc_inflation: float = 0.0,
-        planes: bool = False,
+        planes: bool = True,
     ):
         self.world = world
         self.n = world.arm.dof

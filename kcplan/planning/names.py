@@ -60,7 +60,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-learnall",
     "kc-rrtconnect-noparts",
     "kc-rrtconnect-nofirst",
-    "kc-rrtconnect-planes",
+    "kc-rrtconnect-noplanes",
     "kc-prm-noprobe",
     "kc-rrtconnect-py",
     "kc-prm-py",

@@ -96,7 +96,7 @@ PLANNERS: dict[str, PlannerSpec] = {
         _KC,
         description="stock RRT-Connect, edges certified by free-region planes (exact); "
         "OMPL's default range (0.2 x the space's maximum extent); arms: the chain's "
-        "clearance balls and the KC guards, range ARM_RANGE",
+        "clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
@@ -151,13 +151,13 @@ PLANNERS: dict[str, PlannerSpec] = {
         "world's state checks, every planner's, use those balls either way)",
         part_balls=False,
     ),
-    "kc-rrtconnect-planes": PlannerSpec(
+    "kc-rrtconnect-noplanes": PlannerSpec(
         og.RRTConnect,
         _KC,
-        description="arms: kc-rrtconnect with the free-region planes as well (a link stays "
-        "free of an obstacle while it does not cross the slab between them; rigid robots: as "
-        "kc-rrtconnect)",
-        arm_certificates=("ball", "kc", "region"),
+        description="ablation (arms): kc-rrtconnect without the free-region planes (a link "
+        "stays free of an obstacle while it does not cross the slab between them; rigid "
+        "robots: as kc-rrtconnect)",
+        arm_certificates=("ball", "kc"),
     ),
     "kc-rrtconnect-nofirst": PlannerSpec(
         og.RRTConnect,

@@ -75,9 +75,9 @@ class KCMotionValidator(ob.MotionValidator):
     certificates : sequence of str, optional
         Default ``("region",)``, or ``("rotation",)`` when the world has no
         ``free_regions``; see :data:`kcplan.planning.certifier.CERTIFICATE_SETS`. For an
-        arm ``("ball", "kc")`` (the default: the chain's clearance balls and the KC
-        guards of :mod:`kcplan.planning.arm_certifier`), or ``("ball",)`` with any of
-        ``"kc"`` and ``"region"`` (its free-region planes).
+        arm ``("ball", "kc", "region")`` (the default: the chain's clearance balls, the
+        KC guards and the free-region planes of :mod:`kcplan.planning.arm_certifier`), or
+        ``("ball",)`` with any of ``"kc"`` and ``"region"``.
     fallback : {"bisection", "discrete"}
         What to do with the part of an edge the endpoint guards do not cover: more
         guards (exact, the default) or OMPL-style sampling at the space's
