@@ -128,7 +128,7 @@ double ArmCertifier::plane_reach(const ArmGuard& guard, std::size_t k, double wa
     ++plane_queries;
     if (!world_.body_separations(k, frames(), horizon, guard.separations[k])) {
       guard.separated[k] = -1.0;
-      return 0.0;  // in contact (the measured clearance said otherwise: trust neither)
+      return 0.0;  // in contact, though its clearance said not: the ball alone decides
     }
     guard.separated[k] = horizon;
   }

@@ -181,21 +181,30 @@ class ArmWorld:
 
     def _distance_between(self, a, shape_a, support_a, b: fcl.CollisionObject, support_b) -> float:
         """:meth:`_distance` of the object ``a`` (of geometry ``shape_a``) and ``b``."""
-        result = fcl.DistanceResult()
-        d = fcl.distance(a, b, self._request, result)
+        d, direction = self._nearest_direction(a, shape_a, b)
         if d <= 0.0:
             return 0.0
         if support_b is None:
-            return float(d)
+            return d
+        if direction is None:
+            return 0.0
+        return max(separation(support_a, support_b, direction), 0.0)
+
+    def _nearest_direction(self, a, shape_a, b) -> tuple[float, NDArray | None]:
+        """FCL's distance between the object ``a`` (of geometry ``shape_a``) and ``b`` (0
+        on contact), and the unit direction from ``a``'s nearest point to ``b``'s (None
+        on contact or where the points coincide)."""
+        result = fcl.DistanceResult()
+        d = fcl.distance(a, b, self._request, result)
+        if d <= 0.0:
+            return 0.0, None
         if result.o1 is shape_a:
             p_a, p_b = result.nearest_points
         else:  # FCL swaps some pairs (and their points)
             p_b, p_a = result.nearest_points
         direction = np.asarray(p_b, dtype=float) - np.asarray(p_a, dtype=float)
         length = math.sqrt(float(direction @ direction))
-        if length == 0.0:
-            return 0.0
-        return max(separation(support_a, support_b, direction / length), 0.0)
+        return float(d), (direction / length if length > 0.0 else None)
 
     def in_collision(self, state: ArrayLike) -> bool:
         """Whether a body at ``state`` touches an obstacle or a body it may collide with
@@ -277,25 +286,15 @@ class ArmWorld:
                         normals[k, i], gaps[k, i], clearances[k, i] = line / length, gap, gap
                         exact[k, i] = True
                         continue
-                result = fcl.DistanceResult()
-                d = fcl.distance(obj, piece, self._request, result)
-                if d <= 0.0:
-                    gaps[k, i] = 0.0
-                    continue
-                if support is None:  # a mesh: FCL's distance alone
+                d, direction = self._nearest_direction(obj, self._shapes[k], piece)
+                if d > 0.0 and support is None:  # a mesh: FCL's distance alone
                     clearances[k, i] = d
                     continue
-                if result.o1 is self._shapes[k]:
-                    p_a, p_b = result.nearest_points
-                else:  # FCL swaps some pairs (and their points)
-                    p_b, p_a = result.nearest_points
-                direction = np.asarray(p_b, dtype=float) - np.asarray(p_a, dtype=float)
-                length = math.sqrt(float(direction @ direction))
-                if length == 0.0:
+                if direction is None:  # in contact
                     gaps[k, i] = 0.0
                     continue
-                normals[k, i] = direction / length
-                gaps[k, i] = separation(supports[k], support, normals[k, i])
+                normals[k, i] = direction
+                gaps[k, i] = separation(supports[k], support, direction)
                 clearances[k, i] = max(gaps[k, i], 0.0)
         return normals, gaps, np.where(exact, clearances, self._safe(clearances))
 

@@ -66,7 +66,9 @@ leaves a body short, and cached with its guard.
 clearance to the scene, for bodies that slide past a surface. At a guard body ``k`` and an
 obstacle piece lie on either side of a slab of width ``g`` across a unit ``n``
 (:meth:`kcplan.arm.ArmWorld.separations`: the body in ``{n . x <= b}``, the piece in ``{n .
-x >= b + g}``, from the exact support functions along FCL's direction). A point ``x`` of
+x >= b + g}``, from the exact support functions along the line from a box, ball or
+cylinder's point nearest the body's centre, or else along FCL's nearest points; a poor
+direction only narrows the slab). A point ``x`` of
 the body moves along ``n`` at ``n . (u + w x (x - c)) = n . u + (x - c) . (n x w)`` at the
 guard, at most ``|n . u| + |n x w| a_max`` (``|x - c| <= a_max``), and its acceleration is
 at most ``M`` (as above), so within ``t`` of the guard it crosses at most ``(|n . u| + |n x
@@ -75,8 +77,9 @@ while that is below ``g``. A body's radius is then the smallest over the pieces 
 larger of this root and the ball's reach of the body's distance to that piece alone. The
 hand moving over a table (``n`` vertical, its twist mostly horizontal) so goes much
 farther than its clearance. The kernel measures the slabs of the pieces within the
-horizon the ball needs (every other piece gives at least what is needed), the twin those
-of every piece; the radii differ only where both are at least what is needed.
+horizon the ball needs (every other piece gives at least what is needed), and only for a
+body that limits the radius; the twin measures every slab of every body. The radii
+differ only where both are at least what is needed.
 
 With ``kc_inflation = 0`` this is the ``ca`` certificate of arms (the rigid robots'
 clearance ball with the chain's speeds). The module imports neither OMPL nor FCL (the
