@@ -49,7 +49,8 @@ def yaw_edge(swing: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
 )
 def test_no_point_crosses_a_slab_faster_than_its_bound(panda, states, i, j, m, t, seed):
     """Within t of a guard at q(m) no vertex of a link's hull moves along a unit n farther
-    than (|n . u| + |n x w| a_max) t + M t^2 / 2, on either side: the support function
+    than S t + M t^2 / 2, on either side, S = max |n . u + x . (n x w)| over the hull's
+    vertices x about its centre (at most |n . u| + |n x w| a_max): the support function
     of the hull, moved by Pinocchio's kinematics, against the bound of the twist (w, u)
     and the largest acceleration M there."""
     q1, q2 = states[i], states[j]
@@ -64,7 +65,10 @@ def test_no_point_crosses_a_slab_faster_than_its_bound(panda, states, i, j, m, t
         frames = body_frames(panda, q1 + s * step)
         for k, body in enumerate(panda.bodies):
             a_max = float(np.max(body.semi_axes))
-            across = abs(n[k] @ u[k]) + np.linalg.norm(np.cross(n[k], w[k])) * a_max
+            z = np.cross(n[k], w[k])
+            spread = (body.hull.vertices @ at_m[k][:3, :3].T) @ z
+            across = max(n[k] @ u[k] + spread.max(), -(n[k] @ u[k]) - spread.min())
+            assert across <= abs(n[k] @ u[k]) + np.linalg.norm(z) * a_max + 1e-12
             before = (body.hull.vertices @ at_m[k][:3, :3].T + at_m[k][:3, 3]) @ n[k]
             after = (body.hull.vertices @ frames[k][:3, :3].T + frames[k][:3, 3]) @ n[k]
             assert after.max() - before.max() <= across * t + M[k] * t * t / 2 + 1e-12

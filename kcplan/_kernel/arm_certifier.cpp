@@ -132,14 +132,24 @@ double ArmCertifier::plane_reach(const ArmGuard& guard, std::size_t k, double wa
     }
     guard.separated[k] = horizon;
   }
-  const double a_max = chain_.bodies()[k].a_max;
+  const ChainBody& body = chain_.bodies()[k];
+  // rounding of the speed across: relative, and absolute for a speed near 0
+  const double rounding = 1e-12 * (u_[k].norm() + w_[k].norm() * body.a_max);
   double t = body_reach(guard, k, guard.separated[k]);  // every obstacle beyond the horizon
   for (const ArmWorld::Separation& s : guard.separations[k]) {
     double ts = body_reach(guard, k, s.clearance);
     if (ts >= t) continue;  // this obstacle cannot lower t
     if (s.gap > 0.0) {
-      const double across = (std::abs(s.n.dot(u_[k])) + s.n.cross(w_[k]).norm() * a_max) *
-                            (1.0 + 1e-12);  // and rounding
+      // the fastest any point x moves across: |n . u + (x - c) . (n x w)|, exactly over a
+      // hull's vertices (the largest of a linear function on it), else |x - c| <= a_max
+      const double along = s.n.dot(u_[k]);
+      const coal::Vec3s z = s.n.cross(w_[k]);
+      double across = std::abs(along) + z.norm() * body.a_max;
+      if (body.hull) {
+        const coal::Vec3s local = frames()[k].getRotation().transpose() * z;
+        across = std::max(along + body.hull->support(local), -along + body.hull->support(-local));
+      }
+      across = across * (1.0 + 1e-12) + rounding;
       ts = std::max(ts, root(s.gap, across, accel_[k]));
     }
     t = std::min(t, ts);

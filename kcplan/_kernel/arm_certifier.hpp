@@ -107,6 +107,21 @@ struct ArmCertifierOptions {
 /// larger of the two. A body moving along its long axes may so go much farther than its
 /// clearance. Self pairs keep the ball.
 ///
+/// The plane certificate (planes, with first_order) is a third proof of a body's scene
+/// clearance (ArmWorld::body_separations): the body and each obstacle within the horizon
+/// the ball needs lie on either side of a slab of width g across a unit n at the guard.
+/// Every point x of the body moves across it at |n . u + (x - c) . (n x w)| at the guard
+/// (n . (w x (x - c)) = (x - c) . (n x w)): for a hull at most that of one of its
+/// vertices (a linear function's largest value), else at most |n . u| + |n x w| a_max;
+/// and its acceleration is at most M (Chain::point_accelerations), so within t of the
+/// guard it crosses at most S t + M t^2 / 2 of the slab, S that speed: the body stays on
+/// its side while that is below g. The body's radius is the smallest, over those
+/// obstacles, of the larger of this root and the ball's reach of its distance to that
+/// obstacle alone, and the ball's reach of the horizon for every obstacle beyond it. A
+/// body sliding past a surface (the hand over a table) moves little across it. The planes
+/// cost a region query of the body, so radius() asks them only of a body that limits the
+/// radius, after the balls and the pairs (see there).
+///
 /// `check(q1, q2)` follows OMPL's MotionValidator contract (q1 assumed valid): (1) a state
 /// outside the limits or not finite rejects the edge with no query; (2) q2's validity
 /// (one collision query, cached); (3) the ends' cached guards, which may certify it; (4)

@@ -70,9 +70,10 @@ x >= b + g}``, from the exact support functions along the line from a box, ball 
 cylinder's point nearest the body's centre, or else along FCL's nearest points; a poor
 direction only narrows the slab). A point ``x`` of
 the body moves along ``n`` at ``n . (u + w x (x - c)) = n . u + (x - c) . (n x w)`` at the
-guard, at most ``|n . u| + |n x w| a_max`` (``|x - c| <= a_max``), and its acceleration is
-at most ``M`` (as above), so within ``t`` of the guard it crosses at most ``(|n . u| + |n x
-w| a_max) t + M t^2 / 2`` of the slab, and the body stays on its side, free of the piece,
+guard, for a hull at most that of one of its vertices (a linear function's largest value
+on it), for an ellipsoid at most ``|n . u| + |n x w| a_max``, and its acceleration is
+at most ``M`` (as above), so within ``t`` of the guard it crosses at most ``S t + M t^2 /
+2`` of the slab (``S`` that speed), and the body stays on its side, free of the piece,
 while that is below ``g``. A body's radius is then the smallest over the pieces of the
 larger of this root and the ball's reach of the body's distance to that piece alone. The
 hand moving over a table (``n`` vertical, its twist mostly horizontal) so goes much
@@ -312,9 +313,14 @@ class ArmEdgeCertifier:
                 twist = (twist_speeds(self.arm, w, velocity), accel)
         bodies = stretch_radii(guard.scene, speed, L @ dq, growth, twist)
         if guard.separations is not None:
+            hulls = [  # each hull's vertices about its centre, world axes (None: ellipsoid)
+                None if b.hull is None else b.hull.vertices @ f[:3, :3].T
+                for b, f in zip(self.arm.bodies, body_frames(self.arm, guard.state), strict=True)
+            ]
             planes = _plane_reaches(
-                guard.separations, a.max(axis=1), w, velocity, speed, L @ dq, growth, *twist
-            )
+                guard.separations, a.max(axis=1), hulls, w, velocity, speed, L @ dq, growth,
+                *twist,
+            )  # fmt: skip
             bodies = np.fmax(bodies, planes)
         if guard.grown is not None:
             rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
@@ -465,6 +471,7 @@ def _kc_reaches(
 def _plane_reaches(
     separations: tuple,
     a_max: np.ndarray,
+    hulls: list,
     w: np.ndarray,
     u: np.ndarray,
     v: np.ndarray,
@@ -475,10 +482,13 @@ def _plane_reaches(
 ) -> np.ndarray:
     """The radius each body's slabs give it (module docstring, the plane certificate),
     shape ``(bodies,)``: over the pieces, the smallest of the larger of the ball's reach of
-    the distance to that piece and the root of ``(|n . u| + |n x w| a_max) t + M t^2 / 2 =
-    gap``. ``separations`` is :meth:`kcplan.arm.ArmWorld.separations` at the guard, ``w``
-    and ``u`` the bodies' twists there ``(bodies, 3)``, ``v, A, Q`` and ``(A1, M)`` as for
-    :func:`stretch_radii` ``(bodies,)``."""
+    the distance to that piece and the root of ``S t + M t^2 / 2 = gap``, ``S`` the
+    fastest any point moves across the slab: ``max |n . u + x . (n x w)|`` over the
+    vertices ``x`` of a hull (``hulls[k]``, ``(m, 3)`` about its centre in world axes),
+    ``|n . u| + |n x w| a_max`` for an ellipsoid (``hulls[k]`` None). ``separations`` is
+    :meth:`kcplan.arm.ArmWorld.separations` at the guard, ``w`` and ``u`` the bodies'
+    twists there ``(bodies, 3)``, ``v, A, Q`` and ``(A1, M)`` as for :func:`stretch_radii`
+    ``(bodies,)``."""
     normals, gaps, clearances = separations
     bodies, pieces = gaps.shape
     if pieces == 0:
@@ -487,9 +497,15 @@ def _plane_reaches(
         clearances.ravel(), np.repeat(v, pieces), np.repeat(A, pieces), np.repeat(Q, pieces),
         (np.repeat(A1, pieces), np.repeat(M, pieces)),
     ).reshape(bodies, pieces)  # fmt: skip
-    across = np.abs(np.einsum("kpi,ki->kp", normals, u))
-    across += np.linalg.norm(np.cross(normals, w[:, None, :]), axis=2) * a_max[:, None]
-    across *= 1.0 + 1e-12  # and rounding
+    along = np.einsum("kpi,ki->kp", normals, u)
+    z = np.cross(normals, w[:, None, :])  # (bodies, pieces, 3)
+    across = np.abs(along) + np.linalg.norm(z, axis=2) * a_max[:, None]
+    for k, vertices in enumerate(hulls):
+        if vertices is not None:  # a linear function's largest value on a hull: a vertex's
+            spread = vertices @ z[k].T  # (m, pieces)
+            across[k] = np.maximum(along[k] + spread.max(axis=0), -along[k] - spread.min(axis=0))
+    rounding = 1e-12 * (np.linalg.norm(u, axis=1) + np.linalg.norm(w, axis=1) * a_max)
+    across = across * (1.0 + 1e-12) + rounding[:, None]  # relative, and near 0 absolute
     with np.errstate(divide="ignore", invalid="ignore"):
         slab = np.where(gaps > 0, _root(np.maximum(gaps, 0.0), across, M[:, None]), 0.0)
     return np.fmax(ball, slab).min(axis=1)
