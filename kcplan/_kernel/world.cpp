@@ -363,7 +363,7 @@ void World::add_cylinder(const std::array<double, 3>& centre,
   support.shape[3] = half_height;
   add(std::make_shared<coal::Cylinder>(radius, 2.0 * half_height),
       coal::Transform3s(R, vec(centre)), support,
-      Primitive::cylinder(vec(centre), matrix(rotation), radius, half_height));
+      Primitive::cylinder(vec(centre), R, radius, half_height));
 }
 
 void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles) {

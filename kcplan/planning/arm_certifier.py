@@ -312,10 +312,13 @@ class ArmEdgeCertifier:
             if self.first_order:
                 twist = (twist_speeds(self.arm, w, velocity), accel)
         bodies = stretch_radii(guard.scene, speed, L @ dq, growth, twist)
+        frames = None  # the bodies' frames at the guard, for the planes and the KC guards
+        if guard.separations is not None or guard.grown is not None:
+            frames = body_frames(self.arm, guard.state)
         if guard.separations is not None:
             hulls = [  # each hull's vertices about its centre, world axes (None: ellipsoid)
                 None if b.hull is None else b.hull.vertices @ f[:3, :3].T
-                for b, f in zip(self.arm.bodies, body_frames(self.arm, guard.state), strict=True)
+                for b, f in zip(self.arm.bodies, frames, strict=True)
             ]
             planes = _plane_reaches(
                 guard.separations, a.max(axis=1), hulls, w, velocity, speed, L @ dq, growth,
@@ -323,7 +326,7 @@ class ArmEdgeCertifier:
             )  # fmt: skip
             bodies = np.fmax(bodies, planes)
         if guard.grown is not None:
-            rotations = np.array([f[:3, :3] for f in body_frames(self.arm, guard.state)])
+            rotations = np.array([f[:3, :3] for f in frames])
             kc = _kc_reaches(
                 self.kc_inflation, guard.grown, a, rotations,
                 velocity if self.first_order else None, turn, speed, L @ dq, growth, accel,
