@@ -11,8 +11,8 @@ triangles). Writes a markdown table, a CSV and a plot::
 The default meshes are the Panda hand, link0 and link3 and the UR5 upper arm and forearm
 collision meshes (``../shared/data/external/example-robot-data``) and the L-bracket CAD
 part of the suite; ``--meshes`` gives others. Then come the generated parts of
-:mod:`kcplan.cover.profiles` (a thick ring, a U-channel, a T-profile, a pipe), chosen by
-``--profiles``.
+:mod:`kcplan.cover.profiles` (a thick ring, a U-channel made two ways, a T-profile, a
+pipe), chosen by ``--profiles``.
 """
 
 from __future__ import annotations

@@ -136,7 +136,10 @@ struct World::CollideNear : coal::CollisionCallBackBase {
     result.clear();
     coal::collide(query, obstacle, request, result);
     w.keep(result);
-    hit = result.isCollision();
+    hit = confirmed_contact(result, request.gjk_tolerance, [&] {
+      coal::DistanceResult measured;
+      return coal::distance(query, obstacle, cold_distance_request(), measured);
+    });
     return hit;
   }
 };

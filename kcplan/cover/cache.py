@@ -2,9 +2,10 @@
 
 Entries live in ``$KCPLAN_CACHE_DIR`` (default ``$XDG_CACHE_HOME/kcplan/covers``, else
 ``~/.cache/kcplan/covers``), one JSON file per key: the SHA-256 of the mesh file's bytes
-and of the fit's parameters (bodies, scale, shape, hull, max_offset,
-:data:`kcplan.cover.fit.FIT_VERSION`). An entry is never trusted for soundness: its bodies
-and cutting tree are re-derived and checked against the mesh
+and of the fit's parameters (bodies, scale, shape, hull, max_offset, and the version of
+that kind of fit: :data:`kcplan.cover.fit.FIT_VERSION` by volume,
+:data:`kcplan.cover.fit.OFFSET_FIT_VERSION` by offset). An entry is never trusted for
+soundness: its bodies and cutting tree are re-derived and checked against the mesh
 (:func:`kcplan.cover.fit.check_cover`, the same hull points as the fit), and a stale,
 corrupt or failing entry is refitted and replaced. :data:`BUNDLED`, the covers shipped
 with kcplan, is looked up first, and its entries are checked the same way. The offset
@@ -24,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kcplan.cover.fit import FIT_VERSION, Cover, check_cover, fit_cover
+from kcplan.cover.fit import FIT_VERSION, OFFSET_FIT_VERSION, Cover, check_cover, fit_cover
 from kcplan.cover.solid import Solid, read_solid
 from kcplan.files import write_text_atomic
 from kcplan.geometry.robot import MAX_BODIES, Body
@@ -48,7 +49,8 @@ def cache_folder() -> Path:
 
 def _key(solid: Solid, bodies: int | None, scale: float, shape: str, hull: bool, max_offset) -> str:
     params = {"file": solid.digest, "bodies": bodies, "scale": scale, "shape": shape}
-    params |= {"hull": hull, "max_offset": max_offset, "version": FIT_VERSION}
+    version = FIT_VERSION if max_offset is None else OFFSET_FIT_VERSION
+    params |= {"hull": hull, "max_offset": max_offset, "version": version}
     return hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()
 
 

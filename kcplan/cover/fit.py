@@ -9,13 +9,14 @@ until there are ``bodies`` leaves, or until the bodies' total volume is within
 ``1 + max_excess`` of the part's (the total bounds the union's volume from above).
 
 *Candidate cuts* of a piece are planes across the axes of its ellipsoid and of the part's
-frame, at seven quantiles of the piece's boundary points along each, and the planes of
-the part's largest planar faces (coplanar triangles grouped, at most eight that cross
-the piece). A candidate is scored by the union's volume on a fixed quasi-random sample
-(the same points for every candidate, so comparisons are free of sampling noise), with
-the children fitted to their clipped boundary points only; the chosen children are then
-fitted to their full hull points (cell corners inside the part included), which is what
-makes the cover sound.
+frame, at seven quantiles along each of the part's curvature measure in the piece's cell
+(its edges weighted by their dihedral angles, :mod:`kcplan.cover.features`: where the
+shape changes, whatever its triangulation), and the planes of the part's largest planar
+faces (coplanar triangles grouped, at most eight that cross the piece). A candidate is
+scored by the union's volume on a fixed quasi-random sample (the same points for every
+candidate, so comparisons are free of sampling noise), with the children fitted to their
+clipped boundary points only; the chosen children are then fitted to their full hull
+points (cell corners inside the part included), which is what makes the cover sound.
 
 *Beyond one greedy cut.* When no single cut makes the union smaller, the best three cuts
 of each leaf are tried as the first of a *sequence of two* (their children fitted as if
@@ -63,6 +64,7 @@ from scipy.spatial import ConvexHull, QhullError
 from scipy.stats import qmc
 
 from kcplan.cover.bodies import body_from_ellipsoid, body_holds, body_matrix
+from kcplan.cover.features import clip_segments, feature_segments, quantiles_along, simplex_normals
 from kcplan.cover.partition import Piece
 from kcplan.cover.solid import Solid
 from kcplan.geometry.enclosing import (
@@ -75,10 +77,23 @@ from kcplan.geometry.enclosing import (
 )
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 
-__all__ = ["FIT_VERSION", "MAX_OFFSET_BODIES", "SHAPES", "Cover", "check_cover", "fit_cover"]
+__all__ = [
+    "FIT_VERSION",
+    "MAX_OFFSET_BODIES",
+    "OFFSET_FIT_VERSION",
+    "SHAPES",
+    "Cover",
+    "check_cover",
+    "fit_cover",
+]
 
-FIT_VERSION = 2
-"""Changes whenever the fit would give other bodies for the same input (cache key)."""
+FIT_VERSION = 3
+"""Changes whenever the fit by volume (``bodies`` or ``max_excess``) would give other
+bodies for the same input (cache key). 3: cuts at quantiles of the curvature measure,
+not of the mesh's vertices."""
+OFFSET_FIT_VERSION = 2
+"""The same for a ``max_offset`` fit, whose candidate cuts are its own
+(:data:`OFFSET_FRACTIONS`)."""
 SHAPES = ("ellipsoid", "sphere")
 CUT_QUANTILES = (0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875)
 SEARCH_TOL = 1e-2
@@ -181,6 +196,7 @@ class _Leaf:
     inside: NDArray[np.bool_]  # the score sample's points in the ellipsoid
     outside: float  # the ellipsoid's volume outside the sampled region
     candidates: list | None = None  # from _Search.candidates(), once computed
+    features: tuple | None = None  # the curvature measure in the cell, once clipped
 
 
 def _enclosing(points: NDArray, shape: str, tol: float) -> tuple[NDArray, NDArray]:
@@ -229,13 +245,8 @@ def _face_planes(boundary: NDArray) -> tuple[NDArray, NDArray, NDArray]:
         Area (length in 2D) of the boundary on each plane.
     """
     n = boundary.shape[-1]
-    if n == 3:
-        normal = np.cross(boundary[:, 1] - boundary[:, 0], boundary[:, 2] - boundary[:, 0])
-    else:
-        d = boundary[:, 1] - boundary[:, 0]
-        normal = np.stack([d[:, 1], -d[:, 0]], axis=1)
+    normal, area = simplex_normals(boundary)
     length = np.linalg.norm(normal, axis=1)
-    area = length / (2.0 if n == 3 else 1.0)
     keep = length > 0
     normal = normal[keep] / length[keep, None]
     sign = np.sign(normal[np.arange(len(normal)), np.abs(normal).argmax(axis=1)])
@@ -330,6 +341,7 @@ class _Search:
         self.root = self.leaf(Piece.whole(solid.boundary))
         self.axes = ellipsoid_axes(self.root.M)[1]
         self.pencils = _pencils(self.root.center, self.axes) if pencils else None
+        self.features = feature_segments(solid)
 
     def leaf(self, piece: Piece, points: NDArray | None = None) -> _Leaf:
         """A leaf of the piece, its ellipsoid fitted to its full hull points (``points``,
@@ -383,13 +395,13 @@ class _Search:
 
     def planes(self, leaf: _Leaf) -> list[tuple[NDArray, float]]:
         """Candidate cuts of a leaf as ``(normal, offset)``: across its ellipsoid's and the
-        frame's axes at :data:`CUT_QUANTILES`, then the part's largest face planes and the
+        frame's axes at :meth:`offsets`, then the part's largest face planes and the
         planes of :func:`_pencils` that cross the piece."""
         V = leaf.piece.boundary_points
         out = [
             (normal, float(offset))
             for normal in _directions(leaf.M)
-            for offset in np.unique(np.quantile(V @ normal, CUT_QUANTILES))
+            for offset in np.unique(self.offsets(leaf, normal))
         ]
         if self.faces is not None:
             normals, offsets = self.faces
@@ -400,6 +412,26 @@ class _Search:
             cross = np.flatnonzero(_crossing(V, normals, offsets))
             out += [(normals[i], float(offsets[i])) for i in cross]
         return out
+
+    def offsets(self, leaf: _Leaf, normal: NDArray) -> NDArray:
+        """Where cuts across ``normal`` may cross ``leaf``: the quantiles
+        :data:`CUT_QUANTILES` of the part's curvature measure in the leaf's cell
+        (:mod:`kcplan.cover.features`), or of its surface's area there when the cell
+        holds no feature."""
+        if leaf.features is None:
+            try:
+                cell = ConvexHull(leaf.piece.corners).equations
+            except (QhullError, ValueError):  # a flat cell: no feature is inside it
+                cell = None
+            leaf.features = (
+                clip_segments(*self.features, cell)
+                if cell is not None
+                else (np.zeros((0, 2, self.solid.dimension)), np.zeros(0))
+            )
+        segments, measures = leaf.features
+        if measures.sum() > 0.0:
+            return quantiles_along(segments, normal, CUT_QUANTILES, measures)
+        return quantiles_along(leaf.piece.boundary, normal, CUT_QUANTILES)
 
     def candidates(self, leaf: _Leaf) -> list[tuple]:
         """Candidate cuts of ``leaf`` as ``(normal, offset, covered, outside)``: the sample

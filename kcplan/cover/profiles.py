@@ -1,4 +1,5 @@
-"""Generated CAD-like test parts: a thick ring, a U-channel, a T-profile and a pipe.
+"""Generated CAD-like test parts: a thick ring, a U-channel (made two ways), a T-profile
+and a pipe.
 
 Parts made of a few planar faces or with a hole, on which a greedy cutting tree gets
 stuck (issue 26): ``scripts/cover_tightness.py`` measures them beside the real meshes and
@@ -14,7 +15,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike
 
-__all__ = ["PROFILES", "grid_solid", "pipe", "ring", "t_profile", "u_channel"]
+__all__ = ["PROFILES", "grid_solid", "pipe", "ring", "t_profile", "u_channel", "u_channel_union"]
 
 
 def grid_solid(edges: tuple[ArrayLike, ArrayLike, ArrayLike], filled: ArrayLike) -> trimesh.Trimesh:
@@ -71,6 +72,21 @@ def u_channel() -> trimesh.Trimesh:
     return grid_solid(edges, filled)
 
 
+def u_channel_union() -> trimesh.Trimesh:
+    """The same U-channel as :func:`u_channel`, made as a CAD tool would: the boolean
+    union of its three boxes (trimesh's manifold3d engine; ``pip install manifold3d``,
+    part of kcplan's ``dev`` extra). The solid is the same to float32 rounding, its faces
+    are triangulated otherwise (48 triangles against 44)."""
+    base = trimesh.creation.box((0.6, 0.6, 0.06))
+    base.apply_translation((0.0, 0.0, -0.12))
+    walls = []
+    for y in (0.26, -0.26):
+        wall = trimesh.creation.box((0.6, 0.08, 0.3))
+        wall.apply_translation((0.0, y, 0.0))
+        walls.append(wall)
+    return trimesh.boolean.union([base, *walls], engine="manifold")
+
+
 def t_profile() -> trimesh.Trimesh:
     """A T-profile 0.8 long (x): a flange 0.5 x 0.06 on top of a web 0.06 x 0.4."""
     edges = ([-0.4, 0.4], [-0.25, -0.03, 0.03, 0.25], [-0.2, 0.14, 0.2])
@@ -78,5 +94,11 @@ def t_profile() -> trimesh.Trimesh:
     return grid_solid(edges, filled)
 
 
-PROFILES = {"ring": ring, "u_channel": u_channel, "t_profile": t_profile, "pipe": pipe}
+PROFILES = {
+    "ring": ring,
+    "u_channel": u_channel,
+    "u_channel_union": u_channel_union,
+    "t_profile": t_profile,
+    "pipe": pipe,
+}
 """The generated parts by name."""
