@@ -2,6 +2,7 @@
 them in OMPL, every accepted edge re-checked on the links' own meshes."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -205,3 +206,34 @@ def test_the_validator_chooses_the_arm_certificates(panda, scene):
     for bad in ([0.0], [-1.0], [float("nan")]):
         with pytest.raises(ValueError, match="inflations: expected a KC inflation > 0"):
             KCMotionValidator(si, panda, world, inflations=bad)
+
+
+def test_a_validator_refuses_the_options_of_the_other_kind_of_robot(panda, scene):
+    """The certifier is chosen once (kcplan.planning.certifiers.certifier_for), and each
+    kind of robot has its own options: an arm's validator refuses a rigid robot's option
+    (it used to ignore learn_schedule, horizon, sweep_test and refuse fallback), a rigid
+    robot's refuses an arm's, and a typo is named, all as one ValueError."""
+    from kcplan.planning.certifiers import ARM_OPTIONS, RIGID_OPTIONS
+    from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
+    from kcplan.planning.states import state_space
+    from kcplan.scenarios import load_scenario
+    from kcplan.world.collision import CollisionWorld
+
+    world, _ = scene
+    si = ob.SpaceInformation(joint_space(panda.lower, panda.upper))
+    assert isinstance(KCMotionValidator(si, panda, world).certifier, KernelArmCertifier)
+    for name in sorted(set(RIGID_OPTIONS) - set(ARM_OPTIONS)):
+        with pytest.raises(ValueError, match=rf"^{name}: an option of rigid robots only; the "
+                           r"options of arms are certificates, inflations, max_guards"):
+            KCMotionValidator(si, panda, world, **{name: None})
+    scenario = load_scenario(Path(__file__).parents[1] / "scenarios/2d/narrow_corridor.yaml")
+    rigid = CollisionWorld(scenario)
+    si2 = ob.SpaceInformation(state_space(*scenario.bounds))
+    assert isinstance(KCMotionValidator(si2, rigid.robot, rigid).certifier, KernelCertifier)
+    for name in sorted(set(ARM_OPTIONS) - set(RIGID_OPTIONS)):
+        with pytest.raises(ValueError, match=rf"^{name}: an option of arms only; "):
+            KCMotionValidator(si2, rigid.robot, rigid, **{name: True})
+    with pytest.raises(ValueError, match=r"^horizn: not an option; the options of rigid robots"):
+        KCMotionValidator(si2, rigid.robot, rigid, horizn=1.0)
+    with pytest.raises(ValueError, match=r"^backend: expected 'kernel' or 'python', got 'gpu'"):
+        KCMotionValidator(si2, rigid.robot, rigid, backend="gpu")

@@ -592,8 +592,8 @@ def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | 
             world.robot,
             world,
             spec.certificates,
-            spec.fallback,
             backend=spec.backend,
+            fallback=spec.fallback,
             probes=spec.probes,
             learn_schedule=spec.learn_schedule,
         )
