@@ -273,10 +273,11 @@ bool ArmWorld::pair_collides(std::size_t m, const std::vector<coal::Transform3s>
   coal::collide(shapes_[k].get(), frames[k], shapes_[l].get(), frames[l], request, result);
   guesses_[m] = result.cached_gjk_guess;
   hints_[m] = result.cached_support_func_guess;
-  return confirmed_contact(result, request.gjk_tolerance, [&] {
-    coal::DistanceResult measured;
-    return coal::distance(shapes_[k].get(), frames[k], shapes_[l].get(), frames[l],
-                          cold_distance_request(), measured);
+  return confirmed_contact(result, [&] {
+    coal::CollisionResult cold;
+    coal::collide(shapes_[k].get(), frames[k], shapes_[l].get(), frames[l],
+                  cold_collision_request(), cold);
+    return cold;
   });
 }
 

@@ -136,9 +136,10 @@ struct World::CollideNear : coal::CollisionCallBackBase {
     result.clear();
     coal::collide(query, obstacle, request, result);
     w.keep(result);
-    hit = confirmed_contact(result, request.gjk_tolerance, [&] {
-      coal::DistanceResult measured;
-      return coal::distance(query, obstacle, cold_distance_request(), measured);
+    hit = confirmed_contact(result, [&] {
+      coal::CollisionResult cold;
+      coal::collide(query, obstacle, cold_collision_request(), cold);
+      return cold;
     });
     return hit;
   }
