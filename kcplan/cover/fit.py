@@ -333,7 +333,7 @@ class _EmptySector(Exception):
 class _Search:
     """What the search needs of a part: its fitted leaves and their candidate cuts."""
 
-    def __init__(self, solid: Solid, shape: str, pencils: bool):
+    def __init__(self, solid: Solid, shape: str, pencils: bool, features: tuple | None = None):
         self.solid = solid
         self.shape = shape
         self.scorer = _Scorer(solid)
@@ -341,7 +341,9 @@ class _Search:
         self.root = self.leaf(Piece.whole(solid.boundary))
         self.axes = ellipsoid_axes(self.root.M)[1]
         self.pencils = _pencils(self.root.center, self.axes) if pencils else None
-        self.features = feature_segments(solid)
+        self.features = features
+        """The part's curvature measure (:func:`feature_segments`), on first use (the fit
+        by offset takes none); the searches of one fit share it."""
 
     def leaf(self, piece: Piece, points: NDArray | None = None) -> _Leaf:
         """A leaf of the piece, its ellipsoid fitted to its full hull points (``points``,
@@ -418,6 +420,8 @@ class _Search:
         :data:`CUT_QUANTILES` of the part's curvature measure in the leaf's cell
         (:mod:`kcplan.cover.features`), or of its surface's area there when the cell
         holds no feature."""
+        if self.features is None:
+            self.features = feature_segments(self.solid)
         if leaf.features is None:
             try:
                 cell = ConvexHull(leaf.piece.corners).equations
@@ -552,9 +556,10 @@ def fit_cover(
     if max_excess is not None and not max_excess > 0:
         raise ValueError(f"max_excess: expected a positive number, got {max_excess}")
     start = time.perf_counter()
-    searches = [_Search(solid, shape, pencils=False)]
+    features = feature_segments(solid)  # for every search: a property of the part
+    searches = [_Search(solid, shape, pencils=False, features=features)]
     if PENCIL_ANGLES:
-        searches.append(_Search(solid, shape, pencils=True))
+        searches.append(_Search(solid, shape, pencils=True, features=features))
     target = bodies if bodies is not None else MAX_BODIES
 
     def reporter(label: str) -> Callable[[int], None]:
