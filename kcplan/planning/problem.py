@@ -26,7 +26,9 @@ from kcplan.planning.names import (
     ARM_RANGE,
     CERTIFIABLE,
     JOINT_STEP,
+    OMPL_RANGE,
     PLANNER_NAMES,
+    RIGID_RANGE,
     STOCK,
     check_planner_name,
 )
@@ -70,6 +72,7 @@ class PlannerSpec:
     description: str = ""
     resolution: float | None = None  # OMPL's state validity checking resolution (stock)
     range_factor: float | None = None  # RRT-Connect range, fraction of the maximum extent
+    near: bool = False  # stock: the kc planners' range (ARM_RANGE, RIGID_RANGE), not OMPL's
     neighbors: int | None = None  # PRM's maximum nearest neighbours (OMPL default 10)
     backend: str = "kernel"
     probes: int = DEFAULT_PROBES  # collision probes per edge before its guards (kc)
@@ -94,9 +97,16 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
         _KC,
-        description="stock RRT-Connect, edges certified by free-region planes (exact); "
-        "OMPL's default range (0.2 x the space's maximum extent); arms: the chain's "
-        "clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
+        description="stock RRT-Connect, edges certified by free-region planes (exact), "
+        "range RIGID_RANGE (OMPL's default: 0.2 x the space's maximum extent); arms: the "
+        "chain's clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
+    ),
+    "kc-rrtconnect-wide": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation: kc-rrtconnect at OMPL's default range (0.2 x the space's "
+        "maximum extent), not the kc planners' shorter one",
+        range_factor=OMPL_RANGE,
     ),
     "kc-prm": PlannerSpec(
         og.PRM, _KC, description="stock PRM, roadmap edges certified like kc-rrtconnect"
@@ -239,13 +249,14 @@ for _name, _make, _what in (("rrtconnect", og.RRTConnect, "RRT-Connect"), ("prm"
     )
 PLANNERS["rrtconnect-near"] = replace(
     PLANNERS["rrtconnect"],
-    description="stock RRT-Connect, arms only: the kc planners' range on arms (ARM_RANGE)",
-    range_factor=ARM_RANGE,
+    description="stock RRT-Connect with the kc planners' range (ARM_RANGE on arms, "
+    "RIGID_RANGE on rigid robots)",
+    near=True,
 )
 PLANNERS["rrtconnect-32-near"] = replace(
     PLANNERS["rrtconnect-32"],
     description="rrtconnect-32 with the kc planners' range on arms (ARM_RANGE)",
-    range_factor=ARM_RANGE,
+    near=True,
 )
 PLANNERS["rrtconnect-pin"] = PlannerSpec(
     og.RRTConnect,
@@ -460,8 +471,8 @@ def plan(
     ss.setPlanner(planner_object)
     ss.setup()
     range_factor = spec.range_factor
-    if range_factor is None and spec.kc and setup.joints is not None:
-        range_factor = ARM_RANGE  # an arm's certified edges: shorter pays (ARM_RANGE)
+    if range_factor is None and (spec.kc or spec.near):  # certified edges: shorter pays
+        range_factor = ARM_RANGE if setup.joints is not None else RIGID_RANGE
     if range_factor is not None and hasattr(planner_object, "setRange"):
         planner_object.setRange(range_factor * space.getMaximumExtent())
     if spec.neighbors is not None:
