@@ -312,14 +312,16 @@ UR5_GROUP = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_
         (PANDA / "panda.urdf", GROUP, None, 287, 13184),
         (UR5 / "ur5.urdf", UR5_GROUP, None, 226, 14544),
         (PANDA / "panda.urdf", GROUP, 4, 44, 336),
+        (PANDA / "panda.urdf", GROUP, 2, 22, 84),  # the arm tests' covers (conftest)
+        (PANDA / "panda.urdf", GROUP, 1, 11, 21),
     ],
-    ids=["panda", "ur5", "panda-4"],
+    ids=["panda", "ur5", "panda-4", "panda-2", "panda-1"],
 )
 def test_the_default_covers_come_checked_from_the_bundle(
     urdf, group, per_link, bodies, pairs, tmp_path, monkeypatch
 ):
     """Every machine plans MBM's robots with the same default ellipsoid cover
-    (kcplan/cover/bundled), and the Panda at 4 bodies a link, and none is fitted: the
+    (kcplan/cover/bundled), and the Panda at 4, 2 and 1 bodies a link, and none is fitted: the
     benchmarks' body and pair counts, nothing written to the cache."""
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
     lines: list[str] = []
