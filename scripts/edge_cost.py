@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from kcplan.planning import problem
+from kcplan.planning import setups
 from kcplan.planning.problem import plan
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.scenarios import load_scenario
@@ -101,9 +101,9 @@ class CallTimer:
                      "_valid_kernel_se3"):  # fmt: skip
             self._saved.append((KCMotionValidator, name, getattr(KCMotionValidator, name)))
             setattr(KCMotionValidator, name, self._timed(getattr(KCMotionValidator, name)))
-        checker = problem._kernel_checker
-        self._saved.append((problem, "_kernel_checker", checker))
-        problem._kernel_checker = lambda kernel, n: self._timed(checker(kernel, n))
+        checker = setups.kernel_state_checker
+        self._saved.append((setups, "kernel_state_checker", checker))
+        setups.kernel_state_checker = lambda kernel, n: self._timed(checker(kernel, n))
         return self
 
     def __exit__(self, *exc) -> None:

@@ -14,7 +14,8 @@ from kcplan.arm.world import ArmWorld
 from kcplan.cli import main
 from kcplan.planning.names import ARM_ONLY, JOINT_STEP
 from kcplan.planning.pin_checker import PinChecker
-from kcplan.planning.problem import PLANNERS, _arm_setup, plan
+from kcplan.planning.problem import PLANNERS, plan
+from kcplan.planning.setups import ArmSetup
 from kcplan.scenarios import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -136,7 +137,7 @@ def test_the_32_planners_check_an_edge_every_32nd_of_a_radian(name, table_pick):
     """OMPL's resolution is a fraction of the space's maximum extent (the L2 diagonal of
     the joint box): the -32 planners set it to (1/32) / extent, so that OMPL's discrete
     validator checks an edge of length d at ceil(32 d) states."""
-    setup = _arm_setup(table_pick, PLANNERS[name], None)
+    setup = ArmSetup(table_pick, PLANNERS[name], None)
     space, si = setup.space, setup.si
     extent = space.getMaximumExtent()
     arm = table_pick.arm
@@ -159,5 +160,5 @@ def test_the_32_planners_check_an_edge_every_32nd_of_a_radian(name, table_pick):
         a[j], b[j] = float(q[j]), float(q[j] + (0.3 if j in (0, 3) else 0.0))
     assert si.checkMotion(a, b)
     assert calls[0] == math.ceil(32 * math.hypot(0.3, 0.3)) == 14
-    stock = _arm_setup(table_pick, PLANNERS[name.removesuffix("-32")], None)
+    stock = ArmSetup(table_pick, PLANNERS[name.removesuffix("-32")], None)
     assert stock.si.getStateValidityCheckingResolution() == pytest.approx(0.01)  # OMPL's

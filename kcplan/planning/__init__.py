@@ -1,8 +1,9 @@
 """Planning with OMPL: the motion validator, edge certificates, planners, verification.
 
 :mod:`.guard`, :mod:`.certificates`, :mod:`.certifier`, :mod:`.ladder` and :mod:`.verify`
-do not import OMPL; :mod:`.validator`, :mod:`.states` and :mod:`.problem` are the thin
-OMPL adapters.
+do not import OMPL; :mod:`.validator`, :mod:`.states`, :mod:`.setups` (what each robot
+kind puts into OMPL) and :mod:`.problem` (:func:`~.problem.plan`, the same for every
+kind) are the thin OMPL adapters.
 """
 
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier

@@ -2,7 +2,9 @@
 
 Every planner runs through :func:`plan`, the same setup code: the same state space and
 bounds, the same FCL state validity checker, the same start and goal. The only
-differences are the planner and, for the ``kc-*`` planners, the motion validator.
+differences are the planner and, for the ``kc-*`` planners, the motion validator. What
+depends on the robot's kind (rigid or arm) is :mod:`kcplan.planning.setups`'
+:class:`~kcplan.planning.setups.ProblemSetup`, chosen once per problem.
 """
 
 from __future__ import annotations
@@ -10,7 +12,6 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from ompl import base as ob
@@ -19,29 +20,17 @@ from ompl import util as ou
 
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
-from kcplan.arm.world import ArmWorld
-from kcplan.planning.arm_certifier import DEFAULT_ARM_CERTIFICATES
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.names import (
-    ARM_RANGE,
     CERTIFIABLE,
     JOINT_STEP,
     OMPL_RANGE,
     PLANNER_NAMES,
-    RIGID_RANGE,
     STOCK,
     check_planner_name,
 )
 from kcplan.planning.progress import ProgressRecorder, reports_progress
-from kcplan.planning.states import (
-    joint_space,
-    joint_state,
-    set_joint_state,
-    set_state,
-    state_pose,
-    state_space,
-)
-from kcplan.planning.validator import KCMotionValidator
+from kcplan.planning.setups import setup_for
 from kcplan.planning.verify import PathCheck, verify_path
 from kcplan.scenarios import as_scenario
 from kcplan.world.collision import CollisionWorld
@@ -89,10 +78,6 @@ class PlannerSpec:
 
 
 _KC, _CA, _PAPER = CERTIFICATE_SETS["kc"], CERTIFICATE_SETS["ca"], CERTIFICATE_SETS["kc-paper"]
-_ARM_CERTIFICATES = {_CA: ("ball",)}
-"""What a planner's certificates are on an arm when it names none (``arm_certificates``;
-any other set: :data:`kcplan.planning.arm_certifier.DEFAULT_ARM_CERTIFICATES`): ``ca-*``
-the clearance balls alone."""
 PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect": PlannerSpec(
         og.RRTConnect,
@@ -277,20 +262,6 @@ _SEEDED: list[int] = []
 ou.setLogLevel(ou.LOG_WARN)
 
 
-def _kernel_checker(kernel, n: int):
-    """A state validity checker on the kernel's collision query (one call per state)."""
-    if n == 2:
-        collides2 = kernel.in_collision_se2
-        return lambda s: not collides2(s.getX(), s.getY(), s.getYaw())
-    collides3 = kernel.in_collision_se3
-
-    def state_valid(s) -> bool:
-        r = s.rotation()
-        return not collides3(s.getX(), s.getY(), s.getZ(), r.x, r.y, r.z, r.w)
-
-    return state_valid
-
-
 def seed_ompl(seed: int) -> bool:
     """Seed OMPL's RNG, once per process (OMPL ignores later seeds for determinism).
 
@@ -450,10 +421,7 @@ def plan(
     if seed is not None:
         seed_ompl(seed)
     checker_calls = [0]
-    if isinstance(scenario, ArmScenario):
-        setup = _arm_setup(scenario, spec, world)
-    else:
-        setup = _rigid_setup(scenario, spec, world)
+    setup = setup_for(scenario, spec, world)
     space, ss, si, validator = setup.space, setup.ss, setup.si, setup.validator
 
     def is_valid(state) -> bool:
@@ -472,7 +440,7 @@ def plan(
     ss.setup()
     range_factor = spec.range_factor
     if range_factor is None and (spec.kc or spec.near):  # certified edges: shorter pays
-        range_factor = ARM_RANGE if setup.joints is not None else RIGID_RANGE
+        range_factor = setup.kc_range
     if range_factor is not None and hasattr(planner_object, "setRange"):
         planner_object.setRange(range_factor * space.getMaximumExtent())
     if spec.neighbors is not None:
@@ -532,16 +500,7 @@ def plan(
             counters["kc_simplify_edges"] = simplify_edges
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
-            from kcplan.planning import trajectory as trajectories
-
-            if setup.joints is not None:
-                timed = trajectories.certified_trajectory(
-                    setup.world, states, velocity_limits, acceleration_limits
-                )
-            else:
-                timed = trajectories.timed_rigid_path(
-                    states, scenario.dimension, velocity_limits, acceleration_limits
-                )
+            timed = setup.timed(states, velocity_limits, acceleration_limits)
     finally:
         if validator is not None:
             validator.close()
@@ -567,109 +526,3 @@ def plan(
 
 
 _QUERY_KINDS = ("collision_queries", "distance_queries", "region_queries")
-
-
-@dataclass
-class _Setup:
-    """What :func:`plan` needs of a problem: the OMPL setup, the validator (kc planners),
-    the state validity check and how states are read and written."""
-
-    space: object
-    ss: object
-    si: object
-    world: object
-    validator: KCMotionValidator | None
-    state_valid: Callable
-    read: Callable
-    write: Callable
-    backend: str
-    """Who checks: ``"kernel"`` (compiled, on coal) or ``"python"`` (python-fcl)."""
-    joints: tuple[str, ...] | None = None
-    """An arm's planning group (the states' order); None for a rigid robot."""
-
-
-def _rigid_setup(scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | None) -> _Setup:
-    """SE(2) or SE(3) within the bounds; the kernel's (or python-fcl's) collision query."""
-    n = scenario.dimension
-    world = world or CollisionWorld(scenario)
-    world.reset_counters()
-    space = state_space(*scenario.bounds)
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    validator = None
-    if spec.kc:
-        validator = KCMotionValidator(
-            si,
-            world.robot,
-            world,
-            spec.certificates,
-            backend=spec.backend,
-            fallback=spec.fallback,
-            probes=spec.probes,
-            learn_schedule=spec.learn_schedule,
-        )
-        si.setMotionValidator(validator)
-        state_valid = validator.state_valid  # shares the validator's guard cache
-    elif spec.backend == "kernel":
-        state_valid = _kernel_checker(world.kernel, n)
-    else:
-
-        def state_valid(state) -> bool:
-            return not world.in_collision(state_pose(state, n))
-
-    return _Setup(
-        space, ss, si, world, validator, state_valid,
-        lambda state: state_pose(state, n), lambda state, pose: set_state(state, pose, n),
-        spec.backend,
-    )  # fmt: skip
-
-
-def _arm_setup(scenario: ArmScenario, spec: PlannerSpec, world) -> _Setup:
-    """The group's joint box (the limits); the covers' collision queries, compiled
-    (``backend="kernel"``, on coal) or on python-fcl. For arms the ``ca-*`` planners
-    certify with the chain's clearance balls, the other ``kc-*`` ones with the KC guards
-    as well (:mod:`kcplan.planning.arm_certifier`; inflation: the scenario's
-    ``robot.inflation``, else :data:`~kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`);
-    stock planners check states discretely."""
-    arm = scenario.arm
-    if world is None:
-        world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
-    world.reset_counters()
-    space = joint_space(arm.lower, arm.upper)
-    ss = og.SimpleSetup(space)
-    si = ss.getSpaceInformation()
-    validator = None
-    n = arm.dof
-    if spec.kc:
-        validator = KCMotionValidator(
-            si, arm, world, certificates=spec.arm_certificates
-            or _ARM_CERTIFICATES.get(spec.certificates, DEFAULT_ARM_CERTIFICATES),
-            inflations=[scenario.inflation] if scenario.inflation > 0 else None,
-            backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls,
-            first_order=spec.first_order,
-        )  # fmt: skip
-        si.setMotionValidator(validator)
-        state_valid = validator.state_valid
-    elif spec.backend == "pin":  # rrtconnect-pin: Pinocchio's computeCollisions, by hand
-        from kcplan.planning.pin_checker import PinChecker
-
-        state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
-    elif spec.backend == "kernel":
-        kernel, admits = world.kernel, world.kernel.chain.admits
-
-        def state_valid(state) -> bool:
-            q = [state[j] for j in range(n)]
-            return admits(q) and not kernel.in_collision(q)
-    else:
-
-        def state_valid(state) -> bool:
-            q = joint_state(state, n)
-            return arm.within_limits(q) and not world.in_collision(q)
-
-    if spec.joint_step is not None:  # at most joint_step between checked states (L2, rad)
-        si.setStateValidityCheckingResolution(spec.joint_step / space.getMaximumExtent())
-
-    return _Setup(
-        space, ss, si, world, validator, state_valid,
-        lambda state: joint_state(state, n), set_joint_state, spec.backend, arm.joints,
-    )  # fmt: skip
