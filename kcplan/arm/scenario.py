@@ -262,9 +262,10 @@ def _allowed(r: FieldReader, value: Any) -> frozenset:
 
 
 def _fit_notice(line: str) -> None:
-    """A link cover that had to be fitted (not cached) takes seconds, and one that hit the
-    most bodies sticks out more than asked: say so on stderr."""
-    if "cached" not in line or "stopped at" in line:
+    """A link cover that had to be fitted (not cached, nor bundled with kcplan) takes
+    seconds, and one that hit the most bodies sticks out more than asked: say so on
+    stderr."""
+    if not any(word in line for word in ("cached", "bundled")) or "stopped at" in line:
         print(f"kcplan: covering {line}", file=sys.stderr, flush=True)
 
 
