@@ -44,7 +44,7 @@ RIGID_RANGE = 0.05
 as a fraction of the state space's maximum extent; OMPL's default is 0.2. As on arms, a
 certificate's work grows with the edge's length and a long edge is more often rejected
 after its guards were paid: on HRM's maze and cluttered map with the rabbit (10 seeds)
-kc-rrtconnect's median went from 0.66 to 0.13 s and from 0.15 to 0.08 s (RESULTS 16.6).
+kc-rrtconnect's median went from 0.60 to 0.13 s and from 0.15 to 0.08 s (RESULTS 16.6).
 Stock RRT-Connect gains from it too (``rrtconnect-near``)."""
 
 ARM_ONLY = {
