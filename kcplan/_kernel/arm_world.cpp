@@ -274,10 +274,7 @@ bool ArmWorld::pair_collides(std::size_t m, const std::vector<coal::Transform3s>
   guesses_[m] = result.cached_gjk_guess;
   hints_[m] = result.cached_support_func_guess;
   return confirmed_contact(result, [&] {
-    coal::CollisionResult cold;
-    coal::collide(shapes_[k].get(), frames[k], shapes_[l].get(), frames[l],
-                  cold_collision_request(), cold);
-    return cold;
+    return cold_collision(shapes_[k].get(), frames[k], shapes_[l].get(), frames[l]);
   });
 }
 

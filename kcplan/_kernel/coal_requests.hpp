@@ -2,6 +2,7 @@
 // error was measured (kcplan/_kernel/__init__.py, COAL_CLEARANCE_RTOL).
 #pragma once
 
+#include <coal/collision.h>
 #include <coal/collision_data.h>
 
 namespace kcplan {
@@ -71,12 +72,16 @@ bool confirmed_contact(const coal::CollisionResult& result, Cold&& cold) {
   return again.isCollision() || !(again.distance_lower_bound > kContactBand);
 }
 
-/// The request of confirmed_contact()'s second query: collision_request() from coal's
-/// default guess.
-inline coal::CollisionRequest cold_collision_request() {
+/// confirmed_contact()'s second query: collision_request() from coal's default guess, of
+/// `shapes` (coal::collide's arguments before the request: two objects, or two geometries
+/// each followed by its transform).
+template <class... Shapes>
+coal::CollisionResult cold_collision(const Shapes&... shapes) {
   coal::CollisionRequest request = collision_request();
   request.gjk_initial_guess = coal::GJKInitialGuess::DefaultGuess;
-  return request;
+  coal::CollisionResult result;
+  coal::collide(shapes..., request, result);
+  return result;
 }
 
 }  // namespace kcplan

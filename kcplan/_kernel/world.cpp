@@ -136,11 +136,7 @@ struct World::CollideNear : coal::CollisionCallBackBase {
     result.clear();
     coal::collide(query, obstacle, request, result);
     w.keep(result);
-    hit = confirmed_contact(result, [&] {
-      coal::CollisionResult cold;
-      coal::collide(query, obstacle, cold_collision_request(), cold);
-      return cold;
-    });
+    hit = confirmed_contact(result, [&] { return cold_collision(query, obstacle); });
     return hit;
   }
 };
