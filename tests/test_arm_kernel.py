@@ -328,3 +328,34 @@ def test_queries_between_edges_answer_as_a_fresh_world(panda, world, states):
                 np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
         tried += 1
     assert tried == len(free) - 1 and kernel.counters["guards"] > 20
+
+
+def test_the_twins_screen_every_edge_alike_and_screening_proves_nothing(panda, world, states):
+    """``screen`` (the lazy planner's test of a tree edge) decides as its Python twin,
+    probe by probe; it accepts an edge the certificate rejects once its probes are too
+    sparse to meet the contact, which ``check`` never does."""
+    free = [q for q in states if not world.in_collision(q)][:40]
+    kernel, python = KernelArmCertifier(world), ArmEdgeCertifier(world)
+    decisions = []
+    for q1, q2 in zip(free, free[1:], strict=False):
+        for step in (0.05, 0.2, 1.0):
+            a, b = kernel.screen(q1, q2, step), python.screen(q1, q2, step)
+            assert a == b, (q1, q2, step)
+            decisions.append(a)
+    assert any(decisions) and not all(decisions)
+    k, p = kernel.counters, python.counters
+    assert k["screened_edges"] == p["screened_edges"] == 3 * (len(free) - 1)
+    assert k["probes"] == p["probes"] > 0 and k["guards"] == p["guards"] == 0
+    obstacles = world.obstacles
+    sparse = [
+        (q1, q2)
+        for q1, q2 in zip(free, free[1:], strict=False)
+        if kernel.screen(q1, q2, 100.0) and verify_arm_path(panda, obstacles, [q1, q2]).collides
+    ]
+    assert sparse, "expected an edge that touches between its ends"
+    for q1, q2 in sparse:
+        assert not kernel.check(q1, q2) and not python.check(q1, q2)
+    with pytest.raises(ValueError, match="step"):
+        kernel.screen(free[0], free[1], 0.0)
+    with pytest.raises(ValueError, match="step"):
+        python.screen(free[0], free[1], -1.0)

@@ -237,3 +237,88 @@ def test_a_validator_refuses_the_options_of_the_other_kind_of_robot(panda, scene
         KCMotionValidator(si2, rigid.robot, rigid, horizn=1.0)
     with pytest.raises(ValueError, match=r"^backend: expected 'kernel' or 'python', got 'gpu'"):
         KCMotionValidator(si2, rigid.robot, rigid, backend="gpu")
+
+
+BOX_1 = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "box_1.yaml"
+
+
+def _lazy_setup(scenario, seed: int):
+    """box_1 set up as plan() sets up kc-rrtconnect-lazy (a fresh OMPL setup)."""
+    from kcplan.planning.problem import PLANNERS, seed_ompl
+    from kcplan.planning.setups import setup_for
+
+    seed_ompl(seed)
+    setup = setup_for(scenario, PLANNERS["kc-rrtconnect-lazy"])
+    setup.si.setStateValidityChecker(setup.state_valid)
+    start, goal = setup.si.allocState(), setup.si.allocState()
+    setup.write(start, scenario.start)
+    setup.write(goal, scenario.goal)
+    setup.ss.setStartAndGoalStates(start, goal)
+    planner = og.RRTConnect(setup.si)
+    setup.ss.setPlanner(planner)
+    setup.ss.setup()
+    planner.setRange(setup.kc_range * setup.space.getMaximumExtent())
+    return setup
+
+
+def _assert_certified_and_free(scenario, states) -> None:
+    """Every edge of the path certified by a fresh certifier, and free on the meshes
+    without gaps (kcplan.arm.verify, independent of the certificates)."""
+    from kcplan.planning.certifiers import certifier_for
+
+    world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)
+    fresh = certifier_for(scenario.arm, world)
+    assert all(fresh.check(a, b) for a, b in zip(states, states[1:], strict=False))
+    check = verify_arm_path(scenario.arm, scenario.obstacles, states, allowed=scenario.allowed)
+    assert not check.collides and check.queries > len(states)
+
+
+def test_the_lazy_planner_certifies_every_edge_of_the_path_it_returns():
+    """kc-rrtconnect-lazy screens its trees' edges and certifies the path only: fewer
+    edges certified than screened, and the path it returns is certified edge by edge
+    and free on the meshes."""
+    from kcplan.planning.problem import plan
+    from kcplan.scenarios import load_scenario
+
+    scenario = load_scenario(BOX_1)
+    result = plan(scenario, "kc-rrtconnect-lazy", seed=2, time_limit=20.0, simplify=False)
+    assert result.solved
+    c = result.counters
+    edges = len(result.states) - 1
+    assert c["kc_lazy_attempts"] == c["kc_lazy_rejected_paths"] + 1
+    assert c["kc_screened_edges"] > edges  # every tree edge, not only the path's
+    assert c["kc_edges"] <= c["kc_lazy_attempts"] * edges  # the paths' edges only
+    _assert_certified_and_free(scenario, [np.array(q) for q in result.states])
+
+
+def test_a_path_the_certificate_rejects_starts_the_planner_again_with_denser_probes():
+    """With probes too sparse to see anything (one per 100 rad: the trees check their
+    states only) the planner's first path often crosses the box; the certificate rejects
+    it, the planner starts again with probes twice as dense each time, and the path it
+    finally returns is certified and free. (OMPL is seeded once per process, so the runs
+    are repeated until one meets a rejection: about one in two does.)"""
+    from kcplan.planning.lazy import solve_lazily
+    from kcplan.scenarios import load_scenario
+
+    scenario = load_scenario(BOX_1)
+    setup = _lazy_setup(scenario, seed=4)
+    for _ in range(30):
+        outcome = solve_lazily(setup.ss, setup.validator, setup.read, 30.0, screen_step=100.0)
+        assert outcome.solved and outcome.attempts == outcome.rejected_paths + 1
+        if outcome.rejected_paths:
+            break
+        setup.ss.clear()
+    assert outcome.rejected_paths >= 1
+    assert outcome.screen_step == 100.0 / 2**outcome.rejected_paths
+    assert setup.validator.screen_step is None  # it certifies again
+    states = [setup.read(s) for s in setup.ss.getSolutionPath().getStates()]
+    _assert_certified_and_free(scenario, states)
+    with pytest.raises(ValueError, match="screen_step"):
+        solve_lazily(setup.ss, setup.validator, setup.read, 1.0, screen_step=0.0)
+
+
+def test_the_lazy_planner_is_for_arms_only():
+    from kcplan.planning.problem import plan
+
+    with pytest.raises(ValueError, match="kc-rrtconnect-lazy: for arms only"):
+        plan(BOX_1.parents[1] / "2d" / "narrow_corridor.yaml", "kc-rrtconnect-lazy", seed=1)

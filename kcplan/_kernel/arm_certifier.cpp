@@ -290,8 +290,8 @@ bool ArmCertifier::certified_by_endpoints() {
 }
 
 bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double hi,
-                         double length) {
-  const double wanted = (hi - lo) * length / kProbeStep;
+                         double length, double step) {
+  const double wanted = (hi - lo) * length / step;
   const int count = wanted >= kMaxProbes ? kMaxProbes : static_cast<int>(wanted);
   if (count == 0) return true;
   ++counters.probed_edges;
@@ -308,6 +308,15 @@ bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double h
     if (world_.in_collision(q_.data())) return false;
   }
   return true;
+}
+
+bool ArmCertifier::screen(const double* q1, const double* q2, double step) {
+  if (!(step > 0.0)) throw std::invalid_argument("screen: expected a step > 0");
+  ++screened_edges;
+  if (!chain_.admits(q1) || !chain_.admits(q2) || !state_valid(q2)) return false;
+  double length = 0.0;
+  for (int j = 0; j < n_; ++j) length += (q2[j] - q1[j]) * (q2[j] - q1[j]);
+  return probe(q1, q2, 0.0, 1.0, std::sqrt(length), step);
 }
 
 bool ArmCertifier::state_valid(const double* q) {

@@ -150,6 +150,13 @@ class ArmCertifier {
 
   /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free.
   bool check(const double* q1, const double* q2);
+  /// Whether the edge q1 -> q2 passes the collision queries check() begins with (both
+  /// ends within the limits, q2 valid, no probe over the whole edge in contact: one per
+  /// `step` of joint-space distance, radians L2, at most kMaxProbes), and nothing more.
+  /// Not a proof: the edge may still touch between its probes. A lazy planner screens
+  /// its tree's edges so and certifies only the path it returns with check()
+  /// (kcplan/planning/lazy.py); counted as screened_edges, its queries as probes.
+  bool screen(const double* q1, const double* q2, double step = kProbeStep);
   /// Whether the quadratic Bezier blend B(t) = (1 - t)^2 a + 2 t (1 - t) c + t^2 b,
   /// t in [0, 1] (a, c, b: dof() numbers each, within the limits), is proven free.
   /// B'(t) = 2 ((1 - t) (c - a) + t (b - c)), so |B'_j(t)| <= bound_j = 2 max(|c_j - a_j|,
@@ -202,6 +209,7 @@ class ArmCertifier {
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
   std::int64_t skipped_groups = 0;  ///< groups of pairs a radius decided by their parts
   std::int64_t refined_bodies = 0;  ///< capped scene clearances measured again, uncapped
+  std::int64_t screened_edges = 0;  ///< screen() calls
 
  private:
   std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);
@@ -210,7 +218,8 @@ class ArmCertifier {
   void set_edge(const double* step);
   bool reject(std::int64_t& reason);
   bool certified_by_endpoints();
-  bool probe(const double* q1, const double* q2, double lo, double hi, double length);
+  bool probe(const double* q1, const double* q2, double lo, double hi, double length,
+             double step = kProbeStep);
 
   ArmWorld& world_;
   const Chain& chain_;

@@ -415,6 +415,11 @@ NB_MODULE(_core, m) {
         const kcplan::Chain& chain = c.world().chain();
         return c.check(joints_of(chain, q1), joints_of(chain, q2));
       }, "q1"_a, "q2"_a)
+      .def("screen", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
+                        const std::vector<double>& q2, double step) {
+        const kcplan::Chain& chain = c.world().chain();
+        return c.screen(joints_of(chain, q1), joints_of(chain, q2), step);
+      }, "q1"_a, "q2"_a, "step"_a = kcplan::ArmCertifier::kProbeStep)
       .def("state_valid", [](kcplan::ArmCertifier& c, const std::vector<double>& q) {
         return c.state_valid(joints_of(c.world().chain(), q));
       }, "q"_a)
@@ -440,6 +445,7 @@ NB_MODULE(_core, m) {
         d["kc_reaches"] = c.kc_reaches;
         d["plane_queries"] = c.plane_queries;
         d["plane_reaches"] = c.plane_reaches;
+        d["screened_edges"] = c.screened_edges;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {

@@ -88,12 +88,15 @@ These are the bounds of the clearance-ball certificate for arms: a body whose cl
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.arm.kinematics import body_frames, joint_axes, joint_frames
-from kcplan.arm.model import ArmModel
+
+if TYPE_CHECKING:  # the model calls these functions: no import at run time
+    from kcplan.arm.model import ArmModel
 
 __all__ = [
     "carries",

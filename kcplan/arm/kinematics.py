@@ -15,13 +15,30 @@ frame ``oMi[i] = oMi[parent(i)] @ jointPlacements[i] @ motion_i(q)``, where
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.arm.model import JOINT_KINDS, ArmModel
+if TYPE_CHECKING:  # the model calls these functions: no import at run time
+    from kcplan.arm.model import ArmModel
 
-__all__ = ["body_frames", "joint_axes", "joint_frames", "link_frames"]
+__all__ = ["JOINT_KINDS", "body_frames", "joint_axes", "joint_frames", "link_frames"]
+
+JOINT_KINDS = {
+    "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
+    "JointModelRY": ("revolute", (0.0, 1.0, 0.0)),
+    "JointModelRZ": ("revolute", (0.0, 0.0, 1.0)),
+    "JointModelRevoluteUnaligned": ("revolute", None),
+    "JointModelPX": ("prismatic", (1.0, 0.0, 0.0)),
+    "JointModelPY": ("prismatic", (0.0, 1.0, 0.0)),
+    "JointModelPZ": ("prismatic", (0.0, 0.0, 1.0)),
+    "JointModelPrismaticUnaligned": ("prismatic", None),
+}
+"""Pinocchio joint models a planning group may hold: ``(kind, axis)`` with the axis in
+the joint's frame (None: read from the joint model). A continuous joint (Pinocchio's
+``JointModelRUB*``, two configuration numbers cos and sin) is refused: its angle has no
+limits for a joint-space box."""
 
 
 def joint_axes(arm: ArmModel) -> NDArray[np.float64]:

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from kcplan.files import load_yaml
 from kcplan.geometry.pose import quaternion_matrix
 from kcplan.world.scenario import Obstacle
 
@@ -170,7 +171,7 @@ def _problem(scene: dict, request: dict, scene_source: str, request_source: str)
 
 def _load(text: str | bytes, source: str) -> dict:
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
     except yaml.YAMLError as err:
         raise MbmError(f"{source}: expected YAML, got: {str(err).splitlines()[0]}") from None
     if not isinstance(data, dict):

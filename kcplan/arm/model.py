@@ -51,13 +51,16 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.bounds import speeds
 from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull
+from kcplan.arm.kinematics import JOINT_KINDS, body_frames
 from kcplan.arm.shapes import bvh_mesh
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
 from kcplan.cover.solid import SolidError
 from kcplan.geometry.pose import quaternion_matrix
 from kcplan.geometry.robot import MAX_BODIES
+from kcplan.geometry.robot_model import RobotModel
 
 __all__ = [
     "DEFAULT_MAX_OFFSET",
@@ -98,20 +101,6 @@ manipulator: 2.7e-6 outside), and MoveIt accepts such a state within its bounds 
 REPRESENTATIONS = ("hulls", "ellipsoids")
 """How links are represented (module docstring); the first is the default."""
 
-JOINT_KINDS = {
-    "JointModelRX": ("revolute", (1.0, 0.0, 0.0)),
-    "JointModelRY": ("revolute", (0.0, 1.0, 0.0)),
-    "JointModelRZ": ("revolute", (0.0, 0.0, 1.0)),
-    "JointModelRevoluteUnaligned": ("revolute", None),
-    "JointModelPX": ("prismatic", (1.0, 0.0, 0.0)),
-    "JointModelPY": ("prismatic", (0.0, 1.0, 0.0)),
-    "JointModelPZ": ("prismatic", (0.0, 0.0, 1.0)),
-    "JointModelPrismaticUnaligned": ("prismatic", None),
-}
-"""Pinocchio joint models a planning group may hold: ``(kind, axis)`` with the axis in
-the joint's frame (None: read from the joint model). A continuous joint (Pinocchio's
-``JointModelRUB*``, two configuration numbers cos and sin) is refused: its angle has no
-limits for a joint-space box."""
 
 
 class ArmError(ValueError):
@@ -149,9 +138,13 @@ class ArmBody:
 
 
 @dataclass(frozen=True, eq=False)
-class ArmModel:
+class ArmModel(RobotModel):
     """An arm: the reduced chain of its planning group and the bodies covering its links
     (see the module docstring). Build it with :func:`load_arm`.
+
+    One implementation of :class:`kcplan.geometry.robot_model.RobotModel`: a state is the
+    group's joint vector, an edge the straight joint-space segment, and a body's speed
+    the chain's bound ``sum_j rho[k, j] |q2_j - q1_j|`` (:func:`kcplan.arm.bounds.speeds`).
 
     Attributes
     ----------
@@ -204,9 +197,38 @@ class ArmModel:
         """Number of joints in the planning group (the state's length)."""
         return len(self.joints)
 
+    @property
+    def state_size(self) -> int:
+        """:attr:`dof`: a state is the joint vector."""
+        return self.dof
+
+    @property
+    def workspace_dimension(self) -> int:
+        return 3
+
+    @property
+    def body_count(self) -> int:
+        return len(self.bodies)
+
     def describe(self) -> str:
         """One line for reports: ``arm of 7 joints, 44 bodies (panda.urdf)``."""
         return f"arm of {self.dof} joints, {len(self.bodies)} bodies ({Path(self.urdf).name})"
+
+    def body_frames(self, state: Sequence[float]) -> NDArray[np.float64]:
+        """World frames of the bodies, shape ``(len(bodies), 4, 4)``
+        (:func:`kcplan.arm.kinematics.body_frames`)."""
+        return body_frames(self, state)
+
+    def edge_state(
+        self, state1: Sequence[float], state2: Sequence[float], s: float
+    ) -> NDArray[np.float64]:
+        """``q1 + s (q2 - q1)``: OMPL's interpolation in the joint box."""
+        q1 = np.asarray(state1, dtype=float)
+        return q1 + s * (np.asarray(state2, dtype=float) - q1)
+
+    def body_speeds(self, state1: Sequence[float], state2: Sequence[float]) -> NDArray[np.float64]:
+        """Metres per unit ``s`` (:func:`kcplan.arm.bounds.speeds`)."""
+        return speeds(self, state1, state2)
 
     def configuration(self, state: Sequence[float]) -> NDArray[np.float64]:
         """The reduced model's configuration vector of a state ``(dof,)`` (joint values in

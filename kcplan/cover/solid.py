@@ -26,6 +26,7 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
+from kcplan.files import load_yaml
 from kcplan.geometry.polygon import polygon_area, simple_polygon
 
 __all__ = ["MESH_SUFFIXES", "OUTLINE_SUFFIXES", "Solid", "SolidError", "read_solid"]
@@ -235,7 +236,7 @@ def _outline(source: str, data: bytes, suffix: str, scale: float, digest: str) -
         values = rows
     else:
         try:
-            values = yaml.safe_load(text)
+            values = load_yaml(text)
         except yaml.YAMLError:
             raise SolidError(f"{source}: expected a YAML list of [x, y] vertices") from None
         if isinstance(values, dict) and set(values) == {"vertices"}:

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kcplan.geometry.pose import pose_frame, pose_size, quaternion_multiply
+from kcplan.geometry.pose import Edge, pose_frame, pose_size, quaternion_multiply
+from kcplan.geometry.robot_model import RobotModel
 
 __all__ = ["MAX_BODIES", "Body", "Robot"]
 
@@ -84,8 +85,12 @@ class Body:
         return bool(np.array_equal(self.pose, identity))
 
 
-class Robot:
+class Robot(RobotModel):
     """A rigid robot made of one or more ellipsoidal bodies (see the module docstring).
+
+    One implementation of :class:`kcplan.geometry.robot_model.RobotModel`: a state is a
+    pose, an edge OMPL's interpolation in SE(2) or SE(3) (:class:`kcplan.geometry.pose.
+    Edge`), and body ``k``'s speed ``|t2 - t1| + reach_k |w12|``.
 
     Parameters
     ----------
@@ -171,6 +176,39 @@ class Robot:
         Body ``k`` contains ``B(p_k, a_min,k)``, which contains ``B(0, a_min,k - |p_k|)``.
         """
         return max(0.0, max(float(b.semi_axes.min()) - b.offset for b in self.bodies))
+
+    @property
+    def state_size(self) -> int:
+        """3 (``[x, y, yaw]``) or 7 (``[x, y, z, qx, qy, qz, qw]``)."""
+        return pose_size(self.dimension)
+
+    @property
+    def workspace_dimension(self) -> int:
+        return self.dimension
+
+    @property
+    def body_count(self) -> int:
+        return len(self.bodies)
+
+    def body_frames(self, state: ArrayLike) -> NDArray[np.float64]:
+        """World frames of the bodies at the pose ``state``, shape ``(k, n + 1, n + 1)``
+        (:meth:`body_poses` as homogeneous matrices)."""
+        n = self.dimension
+        R, t = pose_frame(self.body_poses(state), n)
+        frames = np.zeros((len(self.bodies), n + 1, n + 1))
+        frames[:, :n, :n], frames[:, :n, n], frames[:, n, n] = R, t, 1.0
+        return frames
+
+    def edge_state(self, state1: ArrayLike, state2: ArrayLike, s: float) -> NDArray[np.float64]:
+        """The pose at ``s`` of OMPL's interpolation (:meth:`kcplan.geometry.pose.Edge.pose`)."""
+        return Edge(state1, state2, self.dimension).pose(s)
+
+    def body_speeds(self, state1: ArrayLike, state2: ArrayLike) -> NDArray[np.float64]:
+        """``|t2 - t1| + reach_k |w12|`` per body (:meth:`kcplan.geometry.pose.Edge.
+        sweep_speed`; a turn by ``phi`` moves a point at ``r`` from the origin by a chord of
+        at most ``r phi``)."""
+        edge = Edge(state1, state2, self.dimension)
+        return np.array([edge.sweep_speed(b.reach) for b in self.bodies])
 
     def body_poses(self, pose: ArrayLike) -> NDArray[np.float64]:
         """World poses of the bodies at the robot pose ``pose``.

@@ -132,7 +132,8 @@ ARM_COUNTER_NAMES = tuple(
 )
 """The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
 the same meanings, less those of the steps arms do not have (core sweep, occupancy
-grid)."""
+grid). An arm's certifier adds ``screened_edges`` (:meth:`ArmEdgeCertifier.screen`
+calls; their probes count as ``probes``)."""
 
 PROBE_STEP = 0.1
 """Joint-space distance (radians, L2 of the joint vector) per probe; the kernel's twin is
@@ -233,7 +234,7 @@ class ArmEdgeCertifier:
         # joints that carry the first (second) body of a pair only
         self._only = (C[pairs[:, 0]] & ~C[pairs[:, 1]], C[pairs[:, 1]] & ~C[pairs[:, 0]])
         self.cache = GuardCache(cache_entries)
-        self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
+        self.counters = dict.fromkeys((*ARM_COUNTER_NAMES, "screened_edges"), 0)
         self.covered = {"ball": 0.0}
         self._semi_axes = np.array([b.semi_axes for b in self.arm.bodies]).reshape(-1, 3)
         self.fallback = "bisection"
@@ -379,14 +380,29 @@ class ArmEdgeCertifier:
             return self._certified_by_endpoints()
         return self._advance(q1, q2, lo, hi, terms)
 
+    def screen(self, state1: ArrayLike, state2: ArrayLike, step: float = PROBE_STEP) -> bool:
+        """Whether the edge passes the collision queries :meth:`check` begins with, and
+        nothing more: both ends within the limits, ``q2`` valid, and no probe over the
+        whole edge in contact, one per ``step`` radians of joint-space distance (at most
+        :data:`MAX_PROBES`). **Not a proof**: the edge may touch between its probes. A
+        lazy planner screens its tree's edges so and certifies only the path it returns
+        (:mod:`kcplan.planning.lazy`). The kernel's twin is ``ArmCertifier::screen``."""
+        if not step > 0.0:
+            raise ValueError(f"step: expected a joint-space distance > 0, got {step}")
+        self.counters["screened_edges"] += 1
+        q1, q2 = self._joints(state1), self._joints(state2)
+        if not (self._admits(q1) and self._admits(q2) and self.state_valid(q2)):
+            return False
+        return self._probe(q1, q2, 0.0, 1.0, _length(q2 - q1), step)
+
     def _certified_by_endpoints(self) -> bool:
         self.counters["certified_by_endpoints"] += 1
         self.covered["ball"] += 1.0
         return True
 
-    def _probe(self, q1, q2, lo: float, hi: float, length: float) -> bool:
-        """False when a probe of ``[lo, hi]`` collides (module docstring)."""
-        count = min(MAX_PROBES, int((hi - lo) * length / PROBE_STEP))
+    def _probe(self, q1, q2, lo: float, hi: float, length: float, step: float = PROBE_STEP) -> bool:
+        """False when a probe of ``[lo, hi]`` collides (module docstring), one per ``step``."""
+        count = min(MAX_PROBES, int((hi - lo) * length / step))
         if count == 0:
             return True
         self.counters["probed_edges"] += 1

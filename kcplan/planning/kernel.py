@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from kcplan._kernel import ArmCertifier as _CompiledArmCertifier
 from kcplan._kernel import EdgeCertifier as _CompiledCertifier
-from kcplan.planning.arm_certifier import arm_certificates
+from kcplan.planning.arm_certifier import PROBE_STEP, arm_certificates
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
 from kcplan.planning.ladder import GuardLadder
 
@@ -212,6 +212,11 @@ class KernelArmCertifier:
     def state_valid(self, state: ArrayLike) -> bool:
         """One collision query for a state not seen before (remembered)."""
         return self.compiled.state_valid(_joints(state))
+
+    def screen(self, state1: ArrayLike, state2: ArrayLike, step: float = PROBE_STEP) -> bool:
+        """The edge's probes only, not a proof
+        (:meth:`kcplan.planning.arm_certifier.ArmEdgeCertifier.screen`)."""
+        return self.compiled.screen(_joints(state1), _joints(state2), float(step))
 
     @property
     def counters(self) -> dict:

@@ -21,6 +21,7 @@ from ompl import util as ou
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
+from kcplan.planning.lazy import solve_lazily
 from kcplan.planning.names import (
     CERTIFIABLE,
     JOINT_STEP,
@@ -70,6 +71,7 @@ class PlannerSpec:
     first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
     arm_certificates: tuple[str, ...] | None = None  # arms (kc): the validator's, if not by kind
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
+    lazy: bool = False  # arms (kc): screen the tree's edges, certify the path (planning.lazy)
 
     @property
     def kc(self) -> bool:
@@ -85,6 +87,14 @@ PLANNERS: dict[str, PlannerSpec] = {
         description="stock RRT-Connect, edges certified by free-region planes (exact), "
         "range RIGID_RANGE (OMPL's default: 0.2 x the space's maximum extent); arms: the "
         "chain's clearance balls, the KC guards and the free-region planes, range ARM_RANGE",
+    ),
+    "kc-rrtconnect-lazy": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="arms: kc-rrtconnect that screens its trees' edges by probes and "
+        "certifies only the path it returns, starting again with denser probes when the "
+        "certificate rejects an edge of it (kcplan.planning.lazy)",
+        lazy=True,
     ),
     "kc-rrtconnect-wide": PlannerSpec(
         og.RRTConnect,
@@ -450,21 +460,26 @@ def plan(
         objective.setCostThreshold(ob.Cost(math.inf))
 
     recorder = None
-    if progress is not None and reports_progress(planner_object):
+    if progress is not None and reports_progress(planner_object) and not spec.lazy:
         recorder = ProgressRecorder(planner_object, progress)
         stop = recorder.termination_condition(float(time_limit))
     else:
         stop = ob.timedPlannerTerminationCondition(float(time_limit))
+    lazy = None
     try:
-        try:
-            ss.solve(stop)
-        finally:
-            if recorder is not None:
-                recorder.finish()
-        if validator is not None:
-            validator.raise_error()
-        solve_time = float(ss.getLastPlanComputationTime())
-        solved = bool(ss.haveExactSolutionPath())
+        if spec.lazy:  # the path certified after solve(); its time counts as the solve's
+            lazy = solve_lazily(ss, validator, setup.read, float(time_limit))
+            solve_time, solved = lazy.time, lazy.solved
+        else:
+            try:
+                ss.solve(stop)
+            finally:
+                if recorder is not None:
+                    recorder.finish()
+            if validator is not None:
+                validator.raise_error()
+            solve_time = float(ss.getLastPlanComputationTime())
+            solved = bool(ss.haveExactSolutionPath())
         simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
         simplify_edges = 0
         if solved:
@@ -498,6 +513,9 @@ def plan(
         if validator is not None:
             counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
             counters["kc_simplify_edges"] = simplify_edges
+        if lazy is not None:
+            counters["kc_lazy_attempts"] = lazy.attempts
+            counters["kc_lazy_rejected_paths"] = lazy.rejected_paths
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
             timed = setup.timed(states, velocity_limits, acceleration_limits)

@@ -27,6 +27,7 @@ from ompl import geometric as og
 
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.world import ArmWorld
+from kcplan.geometry.robot_model import RobotModel
 from kcplan.planning.arm_certifier import DEFAULT_ARM_CERTIFICATES
 from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.names import ARM_RANGE, RIGID_RANGE
@@ -61,6 +62,9 @@ class ProblemSetup:
     ----------
     space, ss, si
         The OMPL state space, ``SimpleSetup`` and ``SpaceInformation``.
+    robot : RobotModel
+        The robot (:class:`kcplan.geometry.robot_model.RobotModel`: a rigid
+        :class:`~kcplan.geometry.robot.Robot` or an :class:`~kcplan.arm.ArmModel`).
     world
         The collision world the queries go through (its ``counters``).
     validator : KCMotionValidator or None
@@ -81,6 +85,7 @@ class ProblemSetup:
     space: object
     ss: object
     si: object
+    robot: RobotModel
     world: object
     validator: KCMotionValidator | None = None
     state_valid: Callable
@@ -115,6 +120,7 @@ class RigidSetup(ProblemSetup):
     def __init__(self, scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | None):
         self.n = n = scenario.dimension
         self.world = world or CollisionWorld(scenario)
+        self.robot = self.world.robot
         self.world.reset_counters()
         self.backend = spec.backend
         self._open(state_space(*scenario.bounds))
@@ -166,7 +172,7 @@ class ArmSetup(ProblemSetup):
     kc_range = ARM_RANGE
 
     def __init__(self, scenario: ArmScenario, spec: PlannerSpec, world: ArmWorld | None):
-        arm = self.arm = scenario.arm
+        arm = self.robot = self.arm = scenario.arm
         self.world = world or ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
         self.world.reset_counters()
         self.backend, self.joints = spec.backend, arm.joints

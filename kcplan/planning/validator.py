@@ -21,7 +21,9 @@ Contract (OMPL's, as far as the Python binding allows):
 
 * ``checkMotion(s1, s2)`` returns True only when the whole edge, interpolated as OMPL
   does (linear translation, shorter-arc yaw, slerp), is proven free. ``s1`` is assumed
-  valid; ``s2`` is checked.
+  valid; ``s2`` is checked. The one exception is asked for by name: while
+  :attr:`KCMotionValidator.screen_step` is set (a lazy planner growing its tree, arms
+  only) an edge is only screened by probes, and the planner must certify its path.
 * The OMPL 2.0 wheel dispatches only the two-argument ``checkMotion`` to Python. The
   three-argument form (with ``lastValid``) calls it and leaves ``lastValid`` untouched,
   so planners that use it (the KPIECE family) treat a rejected edge as wholly invalid;
@@ -93,6 +95,11 @@ class KCMotionValidator(ob.MotionValidator):
         self.backend = self.certifier.backend
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
+        self.screen_step: float | None = None
+        """None (the default): ``checkMotion`` certifies. A joint-space distance (arms):
+        it only *screens* the edge, probing it every ``screen_step`` radians
+        (``certifier.screen``), which proves nothing; a lazy planner sets it while its
+        tree grows and certifies the path it returns (:mod:`kcplan.planning.lazy`)."""
         arm = isinstance(world, ArmWorld)
         self._read = joint_state if arm else state_pose
         if self.backend != "kernel":
@@ -114,9 +121,11 @@ class KCMotionValidator(ob.MotionValidator):
 
     def _check_kernel_arm(self, s1, s2) -> bool:
         try:
-            n, check = self.n, self.certifier.compiled.check
+            n, step = self.n, self.screen_step
             q1, q2 = [s1[j] for j in range(n)], [s2[j] for j in range(n)]
-            return self.error is None and check(q1, q2)
+            if step is not None:
+                return self.error is None and self.certifier.compiled.screen(q1, q2, step)
+            return self.error is None and self.certifier.compiled.check(q1, q2)
         except Exception as err:  # noqa: BLE001 - see checkMotion
             return self._fail(err)
 
@@ -175,6 +184,8 @@ class KCMotionValidator(ob.MotionValidator):
                 step = self.space.getLongestValidSegmentLength()
                 resolution = min(1.0, step / length) if length > 0 else 1.0
             q1, q2 = self._read(s1, self.n), self._read(s2, self.n)
+            if self.screen_step is not None:
+                return bool(self.certifier.screen(q1, q2, self.screen_step))
             return bool(self.certifier.check(q1, q2, resolution))
         except Exception as err:  # through PRM's C++ threads an exception aborts
             return self._fail(err)  # rejecting is always safe; raise_error() re-raises it

@@ -28,7 +28,7 @@ import numpy as np
 import yaml
 from numpy.typing import NDArray
 
-from kcplan.files import write_text_atomic
+from kcplan.files import load_yaml, write_text_atomic
 from kcplan.geometry.polygon import convex_pieces
 from kcplan.geometry.pose import quaternion_matrix, wrap_angle
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
@@ -74,10 +74,6 @@ DEFAULT_COVER_BODIES = 4
 """Bodies of the cover of ``robot.mesh`` when ``robot.bodies`` is absent."""
 QUATERNION_TOLERANCE = 1e-2
 """Quaternions with | |q| - 1 | up to this are normalised; larger deviations are errors."""
-
-_SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-"""libyaml's safe loader where PyYAML was built with it: it reads a 10,000-obstacle map
-about 4x faster than the pure-Python one, with the same line and column in errors."""
 
 OBSTACLE_KINDS = {
     2: ("box", "ellipse", "circle", "polygon"),
@@ -567,7 +563,7 @@ def read_scenario_data(path: str | os.PathLike) -> tuple[Any, str, Path]:
     except UnicodeDecodeError:
         raise ScenarioError(f"{source}: expected a UTF-8 YAML text file, got binary data") from None
     try:
-        data = yaml.load(text, Loader=_SAFE_LOADER)
+        data = load_yaml(text)
     except yaml.MarkedYAMLError as err:
         mark = err.problem_mark or err.context_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
