@@ -315,10 +315,3 @@ def test_a_path_the_certificate_rejects_starts_the_planner_again_with_denser_pro
     _assert_certified_and_free(scenario, states)
     with pytest.raises(ValueError, match="screen_step"):
         solve_lazily(setup.ss, setup.validator, setup.read, 1.0, screen_step=0.0)
-
-
-def test_the_lazy_planner_is_for_arms_only():
-    from kcplan.planning.problem import plan
-
-    with pytest.raises(ValueError, match="kc-rrtconnect-lazy: for arms only"):
-        plan(BOX_1.parents[1] / "2d" / "narrow_corridor.yaml", "kc-rrtconnect-lazy", seed=1)

@@ -1262,3 +1262,37 @@ def test_kernel_robot_twin_matches_the_python_robot():
         assert len(twin) == len(robot) and twin.is_single == robot.is_single
         assert twin.core_radius == pytest.approx(robot.core_radius)
         assert twin.reach == pytest.approx(robot.reach)
+
+
+@pytest.mark.parametrize("world_name", ["thin_walls", "box_field"])
+def test_the_twins_screen_every_edge_alike_and_screening_proves_nothing(world_name):
+    """``screen`` (the lazy planner's test of a tree edge) decides as its Python twin on
+    the same world (occupancy grid, core sweep, probes) but where coal and FCL see a
+    contact differently (then the edge collides); it accepts edges that touch an
+    obstacle between its probes, which ``check`` rejects and the gap-free verifier
+    finds colliding."""
+    scenario = _scenario(world_name)
+    world = CollisionWorld(scenario)
+    python, kernel = EdgeCertifier(world), KernelCertifier(world)
+    thinnest = min(float(b.semi_axes.min()) for b in scenario.robot.bodies)
+    edges = _edges(world_name)[:300]
+    decisions = {}
+    for step in (0.5 * thinnest, 1e9):
+        py = np.array([python.screen(p1, p2, step) for p1, p2 in edges])
+        kc = np.array([kernel.screen(p1, p2, step) for p1, p2 in edges])
+        differ = np.flatnonzero(py != kc)
+        assert len(differ) <= 0.01 * len(edges)
+        assert all(verify_path(world, list(edges[i])).collides for i in differ)
+        decisions[step] = kc
+    assert python.counters["screened_edges"] == kernel.counters["screened_edges"] == 600
+    assert kernel.counters["probes"] > 0 and kernel.counters["guards"] == 0
+    assert abs(python.counters["probes"] - kernel.counters["probes"]) <= 0.01 * 600 * 64
+    fine, sparse = decisions[0.5 * thinnest], decisions[1e9]
+    missed = [e for e, f, s in zip(edges, fine, sparse, strict=True) if s and not f]
+    assert fine.sum() < sparse.sum() and missed
+    assert any(verify_path(world, [p1, p2]).collides for p1, p2 in missed[:20])
+    assert not any(kernel.check(p1, p2) for p1, p2 in missed[:20])
+    with pytest.raises(ValueError, match="step"):
+        kernel.screen(*edges[0], 0.0)
+    with pytest.raises(ValueError, match="step"):
+        python.screen(*edges[0], -1.0)

@@ -312,7 +312,7 @@ bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double h
 
 bool ArmCertifier::screen(const double* q1, const double* q2, double step) {
   if (!(step > 0.0)) throw std::invalid_argument("screen: expected a step > 0");
-  ++screened_edges;
+  ++counters.screened_edges;
   if (!chain_.admits(q1) || !chain_.admits(q2) || !state_valid(q2)) return false;
   double length = 0.0;
   for (int j = 0; j < n_; ++j) length += (q2[j] - q1[j]) * (q2[j] - q1[j]);

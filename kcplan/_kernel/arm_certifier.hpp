@@ -209,7 +209,6 @@ class ArmCertifier {
   std::int64_t refined_pairs = 0;   ///< pair bounds raised to their GJK distance
   std::int64_t skipped_groups = 0;  ///< groups of pairs a radius decided by their parts
   std::int64_t refined_bodies = 0;  ///< capped scene clearances measured again, uncapped
-  std::int64_t screened_edges = 0;  ///< screen() calls
 
  private:
   std::shared_ptr<const ArmGuard> endpoint(const double* q, const ArmGuardCache::Key& key);

@@ -60,7 +60,7 @@ nb::dict certifier_counters(const kcplan::CertifierCounters& c) {
   KC_COUNTER(guards); KC_COUNTER(endpoint_guards); KC_COUNTER(cached_guards);
   KC_COUNTER(bisection_nodes); KC_COUNTER(collision_queries); KC_COUNTER(occupancy_rejections);
   KC_COUNTER(occupancy_queries); KC_COUNTER(probes);
-  KC_COUNTER(probed_edges);
+  KC_COUNTER(probed_edges); KC_COUNTER(screened_edges);
 #undef KC_COUNTER
   return d;
 }
@@ -227,6 +227,27 @@ NB_MODULE(_core, m) {
                             resolution);
            }, "x1"_a, "y1"_a, "z1"_a, "qx1"_a, "qy1"_a, "qz1"_a, "qw1"_a, "x2"_a, "y2"_a, "z2"_a,
            "qx2"_a, "qy2"_a, "qz2"_a, "qw2"_a, "resolution"_a = 0.01)
+      .def("screen",
+           [](kcplan::EdgeCertifier& c, const std::vector<double>& p1,
+              const std::vector<double>& p2, double step) {
+             const int n = c.world().robot().dimension();
+             return c.screen(pose_of(p1, n), pose_of(p2, n), step);
+           }, "pose1"_a, "pose2"_a, "step"_a)
+      .def("screen_se2",
+           [](kcplan::EdgeCertifier& c, double x1, double y1, double yaw1, double x2, double y2,
+              double yaw2, double step) {
+             require(c.world(), 2);
+             return c.screen(se2(x1, y1, yaw1), se2(x2, y2, yaw2), step);
+           }, "x1"_a, "y1"_a, "yaw1"_a, "x2"_a, "y2"_a, "yaw2"_a, "step"_a)
+      .def("screen_se3",
+           [](kcplan::EdgeCertifier& c, double x1, double y1, double z1, double a1, double b1,
+              double c1, double d1, double x2, double y2, double z2, double a2, double b2,
+              double c2, double d2, double step) {
+             require(c.world(), 3);
+             return c.screen(se3(x1, y1, z1, a1, b1, c1, d1), se3(x2, y2, z2, a2, b2, c2, d2),
+                             step);
+           }, "x1"_a, "y1"_a, "z1"_a, "qx1"_a, "qy1"_a, "qz1"_a, "qw1"_a, "x2"_a, "y2"_a, "z2"_a,
+           "qx2"_a, "qy2"_a, "qz2"_a, "qw2"_a, "step"_a)
       .def("state_valid",
            [](kcplan::EdgeCertifier& c, const std::vector<double>& p) {
              return c.state_valid(pose_of(p, c.world().robot().dimension()));
@@ -445,7 +466,6 @@ NB_MODULE(_core, m) {
         d["kc_reaches"] = c.kc_reaches;
         d["plane_queries"] = c.plane_queries;
         d["plane_reaches"] = c.plane_reaches;
-        d["screened_edges"] = c.screened_edges;
         return d;
       })
       .def_prop_ro("covered", [](const kcplan::ArmCertifier& c) {

@@ -147,7 +147,7 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
     if (world_.sweep_core_collides(edge.pose(lo).t, edge.pose(hi).t, core_radius_))
       return reject(c.rejected_sweep);
   }
-  if (probing() && !probe(edge, lo, hi)) return reject(c.rejected_probe);
+  if (probing() && !probe(edge, lo, hi, probes_)) return reject(c.rejected_probe);
   if (!g1) {
     g1 = endpoint(p1, k1);
     if (g1->clearance <= 0.0) return reject(c.rejected_guard);
@@ -180,11 +180,33 @@ bool EdgeCertifier::learning() {
          learn_pace_.ask(c.occupancy_queries, c.occupancy_rejections + c.rejected_occupancy);
 }
 
-bool EdgeCertifier::probe(const Edge& edge, double lo, double hi) {
+bool EdgeCertifier::screen(const Pose& p1, const Pose& p2, double step) {
+  if (!(step > 0.0)) throw std::invalid_argument("screen: expected a step > 0");
+  if (p1.size != p2.size || p1.size != pose_size(robot_.dimension()))
+    throw std::invalid_argument("pose: expected " + std::to_string(pose_size(robot_.dimension())) +
+                                " numbers per pose");
+  ++counters.screened_edges;
+  if (!domain_.admits(p1) || !domain_.admits(p2)) return false;
+  if (grid_ && (grid_->blocked(p2.t) || grid_->segment_blocked(p1.t, p2.t))) return false;
+  const GuardCache::Key k2 = GuardCache::key(p2);
+  const int known = cache_.validity(k2);
+  if (!(known == 1 || (known < 0 && collision_free(p2, k2)))) return false;
+  const Edge edge(p1, p2);
+  if (sweep_test_) {
+    ++counters.collision_queries;
+    if (world_.sweep_core_collides(p1.t, p2.t, core_radius_)) return false;
+  }
+  const double sweep = edge.translation_speed() + robot_.reach() * edge.rotation_speed();
+  const double wanted = sweep / step;
+  const int count = wanted >= kMaxScreenProbes ? kMaxScreenProbes : static_cast<int>(wanted);
+  return count == 0 || probe(edge, 0.0, 1.0, count);
+}
+
+bool EdgeCertifier::probe(const Edge& edge, double lo, double hi, int count) {
   ++counters.probed_edges;
   // the van der Corput points 1/2, 1/4, 3/4, 1/8, 5/8, 3/8, ...: each probe halves the
   // largest stretch left unprobed, as bisection would
-  for (int i = 1; i <= probes_; ++i) {
+  for (int i = 1; i <= count; ++i) {
     double u = 0.0, bit = 0.5;
     for (int k = i; k > 0; k >>= 1, bit *= 0.5)
       if (k & 1) u += bit;

@@ -56,7 +56,7 @@ struct CertifierCounters {
                certified_by_endpoints = 0, certified_one_guard = 0, guards = 0,
                endpoint_guards = 0, cached_guards = 0, bisection_nodes = 0,
                collision_queries = 0, occupancy_rejections = 0, occupancy_queries = 0,
-               probes = 0, probed_edges = 0;
+               probes = 0, probed_edges = 0, screened_edges = 0;
 
   /// Count how an advancement of `guards` guards ended; whether the edge is certified.
   bool settle(Advanced outcome, int guards) {
@@ -113,6 +113,16 @@ class EdgeCertifier {
   /// Whether the whole edge p1 -> p2 is proven free; `resolution` (in units of s) is the
   /// step of the discrete fallback.
   bool check(const Pose& p1, const Pose& p2, double resolution = 0.01);
+  /// Whether the edge p1 -> p2 passes the cheap tests check() begins with, and nothing
+  /// more: both poses in the domain, p2 and the centre path clear of blocked cells, p2
+  /// valid, the core capsule clear (sweep_test), and no probe in contact, at most `step`
+  /// (length units) of motion of the robot's farthest point apart (|t2 - t1| + reach
+  /// |w12| over the edge; at most kMaxScreenProbes). Not a proof: the edge may touch
+  /// between its probes. A lazy planner screens its trees' edges so and certifies only
+  /// the path it returns with check() (kcplan/planning/lazy.py); counted as
+  /// screened_edges, its probes as probes.
+  bool screen(const Pose& p1, const Pose& p2, double step);
+  static constexpr int kMaxScreenProbes = 64;
   /// State validity with the cache: one collision query for a pose not seen before.
   bool state_valid(const Pose& pose);
   /// One guard query at `pose`, not cached.
@@ -140,7 +150,8 @@ class EdgeCertifier {
   bool reject(std::int64_t& reason);
   bool probing();
   bool learning();
-  bool probe(const Edge& edge, double lo, double hi);
+  /// False when one of `count` probes of [lo, hi] collides.
+  bool probe(const Edge& edge, double lo, double hi, int count);
   bool advance(const Edge& edge, double lo, double hi);
   bool sample(const Edge& edge, double resolution, double lo, double hi);
 

@@ -132,8 +132,7 @@ ARM_COUNTER_NAMES = tuple(
 )
 """The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
 the same meanings, less those of the steps arms do not have (core sweep, occupancy
-grid). An arm's certifier adds ``screened_edges`` (:meth:`ArmEdgeCertifier.screen`
-calls; their probes count as ``probes``)."""
+grid)."""
 
 PROBE_STEP = 0.1
 """Joint-space distance (radians, L2 of the joint vector) per probe; the kernel's twin is
@@ -234,7 +233,7 @@ class ArmEdgeCertifier:
         # joints that carry the first (second) body of a pair only
         self._only = (C[pairs[:, 0]] & ~C[pairs[:, 1]], C[pairs[:, 1]] & ~C[pairs[:, 0]])
         self.cache = GuardCache(cache_entries)
-        self.counters = dict.fromkeys((*ARM_COUNTER_NAMES, "screened_edges"), 0)
+        self.counters = dict.fromkeys(ARM_COUNTER_NAMES, 0)
         self.covered = {"ball": 0.0}
         self._semi_axes = np.array([b.semi_axes for b in self.arm.bodies]).reshape(-1, 3)
         self.fallback = "bisection"

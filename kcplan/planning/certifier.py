@@ -69,8 +69,11 @@ COUNTER_NAMES = (
     "occupancy_queries",
     "probes",
     "probed_edges",
+    "screened_edges",  # screen() calls (a lazy planner's tree edges; their probes: probes)
 )
 
+MAX_SCREEN_PROBES = 64
+"""Probes of one :meth:`EdgeCertifier.screen` at most (the kernel's ``kMaxScreenProbes``)."""
 DEFAULT_PROBES = 3
 """Collision probes per edge before its guards (step 3). Chosen by the ablation of
 ``benchmarks/RESULTS.md`` section 10 (``kc-rrtconnect-noprobe``: none)."""
@@ -418,15 +421,49 @@ class EdgeCertifier:
             return self._sample(edge, resolution, lo, hi)
         return self._advance(edge, lo, hi)
 
+    def screen(self, pose1: ArrayLike, pose2: ArrayLike, step: float) -> bool:
+        """Whether the edge passes the cheap tests :meth:`check` begins with, and nothing
+        more: both poses in :attr:`domain`, ``pose2`` and the centre path clear of blocked
+        cells, ``pose2`` valid, the core capsule clear (``sweep_test``), and no probe in
+        contact, at most ``step`` (length units) of motion of the robot's farthest point
+        apart (``|t2 - t1| + reach |w12|`` over the edge; at most
+        :data:`MAX_SCREEN_PROBES`). **Not a proof**: the edge may touch between its
+        probes. A lazy planner screens its trees' edges so and certifies only the path
+        it returns (:mod:`kcplan.planning.lazy`). The kernel's twin is
+        ``EdgeCertifier::screen``."""
+        if not step > 0.0:
+            raise ValueError(f"step: expected a length > 0, got {step}")
+        p1, p2 = np.asarray(pose1, dtype=float), np.asarray(pose2, dtype=float)
+        if p1.shape != p2.shape or p1.size != pose_size(self.n):
+            raise ValueError(f"pose: expected {pose_size(self.n)} numbers per pose")
+        self.counters["screened_edges"] += 1
+        if not (self.domain.admits(p1) and self.domain.admits(p2)):
+            return False
+        grid = self._occupancy()
+        if grid is not None and (grid.blocked(p2) or grid.segment_blocked(p1, p2)):
+            return False
+        k2 = p2.tobytes()
+        known = self.cache.validity(k2)
+        if not (known or (known is None and self._collision_free(p2, k2))):
+            return False
+        edge = Edge(p1, p2, self.n)
+        if self.sweep_test:
+            self.counters["collision_queries"] += 1
+            if self.world.sweep_core_collides(p1, p2, self.core_radius):
+                return False
+        count = min(MAX_SCREEN_PROBES, int(edge.sweep_speed(self.robot.reach) / step))
+        return count == 0 or self._probe(edge, 0.0, 1.0, count)
+
     def _probing(self) -> bool:
         """Whether this edge is probed (the schedule of :data:`PROBE_WARMUP`)."""
         probed, rejected = self.counters["probed_edges"], self.counters["rejected_probe"]
         return self.probes > 0 and self._probe_pace.ask(probed, rejected)
 
-    def _probe(self, edge: Edge, lo: float, hi: float) -> bool:
-        """False when one of the probes of ``[lo, hi]`` collides."""
+    def _probe(self, edge: Edge, lo: float, hi: float, count: int | None = None) -> bool:
+        """False when one of ``count`` (default :attr:`probes`) probes of ``[lo, hi]``
+        collides."""
         self.counters["probed_edges"] += 1
-        for u in probe_points(self.probes):
+        for u in probe_points(self.probes if count is None else count):
             self.counters["probes"] += 1
             self.counters["collision_queries"] += 1
             if self.world.in_collision(edge.pose(lo + u * (hi - lo))):

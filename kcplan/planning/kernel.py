@@ -104,6 +104,7 @@ class KernelCertifier:
         self.check_se2, self.check_se3 = self._kernel.check_se2, self._kernel.check_se3
         self.state_valid_se2 = self._kernel.state_valid_se2
         self.state_valid_se3 = self._kernel.state_valid_se3
+        self.screen_se2, self.screen_se3 = self._kernel.screen_se2, self._kernel.screen_se3
 
     @property
     def ladder(self) -> GuardLadder | None:
@@ -132,6 +133,11 @@ class KernelCertifier:
     def state_valid(self, pose: ArrayLike) -> bool:
         """State validity with the cache (one collision query for a pose not seen before)."""
         return self._kernel.state_valid(_flat(pose))
+
+    def screen(self, pose1: ArrayLike, pose2: ArrayLike, step: float) -> bool:
+        """The edge's cheap tests and probes only, not a proof
+        (:meth:`kcplan.planning.certifier.EdgeCertifier.screen`)."""
+        return self._kernel.screen(_flat(pose1), _flat(pose2), float(step))
 
     def measure(self, pose: ArrayLike) -> tuple[float, list]:
         """One guard query at ``pose`` (not cached): ``(clearance, bodies)`` with, per

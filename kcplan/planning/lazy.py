@@ -6,7 +6,8 @@ LazyPRM, which the OMPL 2.0 wheel does not expose) pays the full price only for 
 candidate path's edges. :func:`solve_lazily` does that around any single-query planner:
 
 1. the motion validator only *screens* edges (:attr:`KCMotionValidator.screen_step`):
-   the end state and collision probes every ``screen_step`` radians, no proof;
+   the end state and collision probes every ``screen_step`` (radians of joint-space
+   distance for an arm, length units of motion for a rigid robot), no proof;
 2. when the planner returns a path, every edge of it is certified as an eager planner's
    would be (the certifier's ``check``: guards, certificates, no gap);
 3. if an edge is rejected (it touches between the probes, or its proof needs more
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 
 from ompl import base as ob
 
-__all__ = ["LAZY_SCREEN_STEP", "LazyOutcome", "solve_lazily"]
+__all__ = ["LAZY_SCREEN_STEP", "RIGID_SCREEN_STEP", "LazyOutcome", "solve_lazily"]
 
 LAZY_SCREEN_STEP = 0.1
 """The first attempt's screening step, radians of joint-space distance (L2) per probe: the
@@ -34,6 +35,11 @@ eager certifier's probe step (``PROBE_STEP``), between VAMP's 1/32 rad and the 0
 of OMPL's default resolution on the Panda. On 35 MBM Panda problems 0.2 screened for
 less but a quarter more paths were rejected, each throwing its trees away: the sum of
 times 0.425 s against 0.321 s at 0.1 (RESULTS 17)."""
+
+RIGID_SCREEN_STEP = 1.0
+"""A rigid robot's first screening step, as a multiple of its thinnest semi-axis: probes at
+most that far apart in the motion of the robot's farthest point, so that the robot's
+placements at two probes overlap (RESULTS 17)."""
 
 
 @dataclass(frozen=True)
@@ -51,7 +57,7 @@ class LazyOutcome:
     rejected_paths : int
         Paths returned by the planner that had an edge the certificate rejected.
     screen_step : float
-        The last attempt's screening step (radians).
+        The last attempt's screening step.
     """
 
     solved: bool
@@ -75,13 +81,15 @@ def solve_lazily(
     ss : ompl.geometric.SimpleSetup
         Set up, with ``validator`` installed as its motion validator.
     validator : KCMotionValidator
-        Its certifier must have ``screen`` (arms).
+        Certifying ``ss``'s edges (kernel or Python, any robot).
     read : callable
         An OMPL state to the certifier's numpy state (``ProblemSetup.read``).
     time_limit : float
         Seconds for everything.
     screen_step : float
-        The first attempt's screening step (radians, > 0).
+        The first attempt's screening step (> 0): radians for an arm
+        (:data:`LAZY_SCREEN_STEP`), length units for a rigid robot
+        (:data:`RIGID_SCREEN_STEP` times its thinnest semi-axis).
 
     Returns
     -------
@@ -90,7 +98,7 @@ def solve_lazily(
         has none. The validator certifies again on return.
     """
     if not screen_step > 0.0:
-        raise ValueError(f"screen_step: expected a joint-space distance > 0, got {screen_step}")
+        raise ValueError(f"screen_step: expected a step > 0, got {screen_step}")
     start = time.perf_counter()
     attempts = rejected = 0
     step = screen_step

@@ -48,8 +48,6 @@ kc-rrtconnect's median went from 0.60 to 0.13 s and from 0.15 to 0.08 s (RESULTS
 Stock RRT-Connect gains from it too (``rrtconnect-near``)."""
 
 ARM_ONLY = {
-    "kc-rrtconnect-lazy": "kc-rrtconnect screening its trees' edges by joint-space probes "
-    "and certifying only the path it returns",
     "rrtconnect-32-near": "rrtconnect-32 with the kc planners' range on arms (ARM_RANGE)",
     "rrtconnect-32": "stock RRT-Connect checking an edge every 1/32 rad of joint-space "
     "distance, which only an arm's joint space has",
@@ -67,6 +65,7 @@ PLANNER_NAMES = (
     "ca-prm",
     "kc-rrtconnect-paper",
     "kc-prm-paper",
+    "kc-rrtconnect-lazy",
     "kc-rrtconnect-wide",
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",

@@ -71,7 +71,7 @@ class PlannerSpec:
     first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
     arm_certificates: tuple[str, ...] | None = None  # arms (kc): the validator's, if not by kind
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
-    lazy: bool = False  # arms (kc): screen the tree's edges, certify the path (planning.lazy)
+    lazy: bool = False  # kc: screen the trees' edges, certify the path (planning.lazy)
 
     @property
     def kc(self) -> bool:
@@ -91,9 +91,9 @@ PLANNERS: dict[str, PlannerSpec] = {
     "kc-rrtconnect-lazy": PlannerSpec(
         og.RRTConnect,
         _KC,
-        description="arms: kc-rrtconnect that screens its trees' edges by probes and "
-        "certifies only the path it returns, starting again with denser probes when the "
-        "certificate rejects an edge of it (kcplan.planning.lazy)",
+        description="kc-rrtconnect that screens its trees' edges by probes and certifies "
+        "only the path it returns, starting again with denser probes when the certificate "
+        "rejects an edge of it (kcplan.planning.lazy)",
         lazy=True,
     ),
     "kc-rrtconnect-wide": PlannerSpec(
@@ -468,7 +468,7 @@ def plan(
     lazy = None
     try:
         if spec.lazy:  # the path certified after solve(); its time counts as the solve's
-            lazy = solve_lazily(ss, validator, setup.read, float(time_limit))
+            lazy = solve_lazily(ss, validator, setup.read, float(time_limit), setup.screen_step)
             solve_time, solved = lazy.time, lazy.solved
         else:
             try:

@@ -30,6 +30,7 @@ from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot_model import RobotModel
 from kcplan.planning.arm_certifier import DEFAULT_ARM_CERTIFICATES
 from kcplan.planning.certifier import CERTIFICATE_SETS
+from kcplan.planning.lazy import LAZY_SCREEN_STEP, RIGID_SCREEN_STEP
 from kcplan.planning.names import ARM_RANGE, RIGID_RANGE
 from kcplan.planning.states import (
     joint_space,
@@ -77,6 +78,8 @@ class ProblemSetup:
         ``"pin"`` (Pinocchio).
     joints : tuple of str or None
         An arm's planning group (the states' order); None for a rigid robot.
+    screen_step : float
+        A lazy planner's first screening step (:mod:`kcplan.planning.lazy`).
     kc_range : float
         The kc planners' range, a fraction of the space's maximum extent
         (:data:`~kcplan.planning.names.RIGID_RANGE`, :data:`~kcplan.planning.names.ARM_RANGE`).
@@ -92,6 +95,7 @@ class ProblemSetup:
     backend: str
     joints: tuple[str, ...] | None = None
     kc_range: float
+    screen_step: float
 
     def read(self, state) -> NDArray[np.float64]:
         """The state's values: a flat pose, or a joint vector."""
@@ -121,6 +125,8 @@ class RigidSetup(ProblemSetup):
         self.n = n = scenario.dimension
         self.world = world or CollisionWorld(scenario)
         self.robot = self.world.robot
+        thinnest = min(float(b.semi_axes.min()) for b in self.robot.bodies)
+        self.screen_step = RIGID_SCREEN_STEP * thinnest
         self.world.reset_counters()
         self.backend = spec.backend
         self._open(state_space(*scenario.bounds))
@@ -170,6 +176,7 @@ class ArmSetup(ProblemSetup):
     planner sets one."""
 
     kc_range = ARM_RANGE
+    screen_step = LAZY_SCREEN_STEP
 
     def __init__(self, scenario: ArmScenario, spec: PlannerSpec, world: ArmWorld | None):
         arm = self.robot = self.arm = scenario.arm

@@ -22,8 +22,8 @@ Contract (OMPL's, as far as the Python binding allows):
 * ``checkMotion(s1, s2)`` returns True only when the whole edge, interpolated as OMPL
   does (linear translation, shorter-arc yaw, slerp), is proven free. ``s1`` is assumed
   valid; ``s2`` is checked. The one exception is asked for by name: while
-  :attr:`KCMotionValidator.screen_step` is set (a lazy planner growing its tree, arms
-  only) an edge is only screened by probes, and the planner must certify its path.
+  :attr:`KCMotionValidator.screen_step` is set (a lazy planner growing its trees) an
+  edge is only screened by probes, and the planner must certify its path.
 * The OMPL 2.0 wheel dispatches only the two-argument ``checkMotion`` to Python. The
   three-argument form (with ``lastValid``) calls it and leaves ``lastValid`` untouched,
   so planners that use it (the KPIECE family) treat a rejected edge as wholly invalid;
@@ -96,10 +96,11 @@ class KCMotionValidator(ob.MotionValidator):
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
         self.screen_step: float | None = None
-        """None (the default): ``checkMotion`` certifies. A joint-space distance (arms):
-        it only *screens* the edge, probing it every ``screen_step`` radians
-        (``certifier.screen``), which proves nothing; a lazy planner sets it while its
-        tree grows and certifies the path it returns (:mod:`kcplan.planning.lazy`)."""
+        """None (the default): ``checkMotion`` certifies. A step: it only *screens* the
+        edge (``certifier.screen``: probes at most ``screen_step`` apart, radians of
+        joint-space distance for an arm, length units of the robot's farthest point's
+        motion for a rigid robot), which proves nothing; a lazy planner sets it while
+        its trees grow and certifies the path it returns (:mod:`kcplan.planning.lazy`)."""
         arm = isinstance(world, ArmWorld)
         self._read = joint_state if arm else state_pose
         if self.backend != "kernel":
@@ -144,19 +145,23 @@ class KCMotionValidator(ob.MotionValidator):
 
     def _check_kernel_se2(self, s1, s2) -> bool:
         try:
-            return self.error is None and self.certifier.check_se2(
-                s1.getX(), s1.getY(), s1.getYaw(), s2.getX(), s2.getY(), s2.getYaw()
-            )
+            args = (s1.getX(), s1.getY(), s1.getYaw(), s2.getX(), s2.getY(), s2.getYaw())
+            if self.screen_step is not None:
+                return self.error is None and self.certifier.screen_se2(*args, self.screen_step)
+            return self.error is None and self.certifier.check_se2(*args)
         except Exception as err:  # noqa: BLE001 - see checkMotion
             return self._fail(err)
 
     def _check_kernel_se3(self, s1, s2) -> bool:
         try:
             r1, r2 = s1.rotation(), s2.rotation()
-            return self.error is None and self.certifier.check_se3(
+            args = (
                 s1.getX(), s1.getY(), s1.getZ(), r1.x, r1.y, r1.z, r1.w,
                 s2.getX(), s2.getY(), s2.getZ(), r2.x, r2.y, r2.z, r2.w,
             )  # fmt: skip
+            if self.screen_step is not None:
+                return self.error is None and self.certifier.screen_se3(*args, self.screen_step)
+            return self.error is None and self.certifier.check_se3(*args)
         except Exception as err:  # noqa: BLE001 - see checkMotion
             return self._fail(err)
 
