@@ -52,7 +52,10 @@ from kcplan.scenarios import dump_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"
-PLANNERS = "kc-rrtconnect,rrtconnect,rrtconnect-32,rrtconnect-32-near,rrtconnect-pin"
+PLANNERS = ",".join((
+    "kc-rrtconnect", "kc-rrtconnect-lazy", "rrtconnect", "rrtconnect-32", "rrtconnect-32-near",
+    "rrtconnect-pin",
+))  # fmt: skip
 ROBOTS = {  # URDF and SRDF of each robot: the bundled Panda, the UR5 as MBM ships it
     "panda": (ROOT / "scenarios" / "arm" / "panda" / "panda.urdf",
               ROOT / "scenarios" / "arm" / "panda" / "panda.srdf"),

@@ -201,6 +201,15 @@ CASES = [
         ),
     ),
     Case(
+        "arm_edge_cost.py",
+        ("scenarios/arm/box_1.yaml", "--seed", "2", "--time", "5", "--planner")
+        + ("kc-rrtconnect-lazy",),
+        (
+            r"^box_1, kc-rrtconnect-lazy, seed 2: solved in ",
+            rf"^\| screened \| [1-9]\d* \| {NUMBER} \| {NUMBER} \| \d+% \|$",
+        ),
+    ),
+    Case(
         "hrm_settings_check.py",
         ("--hrm", "{hrm}"),
         (r"\| map \| robot \|", r"\| sparse \| \w+ \| [^|]+ \| [^|]+ \| (yes|no) \|"),
