@@ -45,8 +45,10 @@ class ArmCallTimer:
             t0 = time.perf_counter()
             ok = edge(validator, s1, s2)
             # a lazy planner's tree edges are screened, not certified (kcplan.planning.lazy)
-            kind = "screened" if validator.screen_step is not None else None
-            kind = kind or ("certified" if ok else "rejected")
+            if validator.screen_step is not None:
+                kind = "screened"
+            else:
+                kind = "certified" if ok else "rejected"
             self.times[kind].append(time.perf_counter() - t0)
             return ok
 

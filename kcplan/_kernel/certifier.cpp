@@ -109,12 +109,16 @@ bool EdgeCertifier::reject(std::int64_t& reason) {
   return false;
 }
 
-bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
-  CertifierCounters& c = counters;
-  ++c.edges;
+void EdgeCertifier::require_poses(const Pose& p1, const Pose& p2) const {
   if (p1.size != p2.size || p1.size != pose_size(robot_.dimension()))
     throw std::invalid_argument("pose: expected " + std::to_string(pose_size(robot_.dimension())) +
                                 " numbers per pose");
+}
+
+bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
+  CertifierCounters& c = counters;
+  ++c.edges;
+  require_poses(p1, p2);
   if (!domain_.admits(p1) || !domain_.admits(p2)) return reject(c.rejected_end_state);
   const GuardCache::Key k1 = GuardCache::key(p1), k2 = GuardCache::key(p2);
   CoreOccupancy* grid = grid_ ? &*grid_ : nullptr;
@@ -182,9 +186,7 @@ bool EdgeCertifier::learning() {
 
 bool EdgeCertifier::screen(const Pose& p1, const Pose& p2, double step) {
   if (!(step > 0.0)) throw std::invalid_argument("screen: expected a step > 0");
-  if (p1.size != p2.size || p1.size != pose_size(robot_.dimension()))
-    throw std::invalid_argument("pose: expected " + std::to_string(pose_size(robot_.dimension())) +
-                                " numbers per pose");
+  require_poses(p1, p2);
   ++counters.screened_edges;
   if (!domain_.admits(p1) || !domain_.admits(p2)) return false;
   if (grid_ && (grid_->blocked(p2.t) || grid_->segment_blocked(p1.t, p2.t))) return false;

@@ -143,6 +143,8 @@ class EdgeCertifier {
   CertifierCounters counters;
 
  private:
+  /// std::invalid_argument unless both poses have the robot's pose size.
+  void require_poses(const Pose& p1, const Pose& p2) const;
   bool collision_free(const Pose& p, const GuardCache::Key& key);
   std::shared_ptr<const Guard> endpoint(const Pose& pose, const GuardCache::Key& key);
   void reach(const Guard& guard, const Edge& edge, double m, double s0, double s1, double& lo,

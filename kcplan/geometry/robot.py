@@ -169,6 +169,11 @@ class Robot(RobotModel):
         return max(float(b.semi_axes.max()) for b in self.bodies)
 
     @property
+    def smallest_semi_axis(self) -> float:
+        """The smallest semi-axis of any body (the robot's thinnest part)."""
+        return min(float(b.semi_axes.min()) for b in self.bodies)
+
+    @property
     def core_radius(self) -> float:
         """Radius of a ball about the robot's origin that the robot contains in every
         orientation; 0 when no body covers the origin.

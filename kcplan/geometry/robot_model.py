@@ -1,9 +1,11 @@
 """What every kind of robot says about itself: one concept, two implementations.
 
-A certifier proves an edge free from three things only: the robot's states, where its
+Every certificate rests on three things a robot says about itself: its states, where its
 bodies are at a state, and how far any point of a body can move along the edge between
-two states. :class:`RobotModel` is that contract; the planners, the certifiers and the
-verifiers ask nothing else of a robot's kind:
+two states (a guard's clearance divided by that speed is the stretch it proves, before
+any sharper bound). :class:`RobotModel` is that contract, which each kind of robot keeps;
+the certifiers add their own sharper, kind-specific bounds (the rigid robots' levers and
+KC sets, the arms' chain bounds) on top of it:
 
 * :class:`kcplan.geometry.robot.Robot`: a rigid robot of ellipses (2D) or ellipsoids
   (3D); its state is a pose ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]``, an edge is

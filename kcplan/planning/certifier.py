@@ -365,10 +365,7 @@ class EdgeCertifier:
         :class:`kcplan.planning.domain.PoseDomain`) is rejected (``rejected_end_state``)."""
         c = self.counters
         c["edges"] += 1
-        p1 = np.asarray(pose1, dtype=float)
-        p2 = np.asarray(pose2, dtype=float)
-        if p1.shape != p2.shape or p1.size != pose_size(self.n):
-            raise ValueError(f"pose: expected {pose_size(self.n)} numbers per pose")
+        p1, p2 = self._poses(pose1, pose2)
         if not (self.domain.admits(p1) and self.domain.admits(p2)):
             return self._reject("rejected_end_state")  # never free
         k1, k2 = p1.tobytes(), p2.tobytes()
@@ -433,9 +430,7 @@ class EdgeCertifier:
         ``EdgeCertifier::screen``."""
         if not step > 0.0:
             raise ValueError(f"step: expected a length > 0, got {step}")
-        p1, p2 = np.asarray(pose1, dtype=float), np.asarray(pose2, dtype=float)
-        if p1.shape != p2.shape or p1.size != pose_size(self.n):
-            raise ValueError(f"pose: expected {pose_size(self.n)} numbers per pose")
+        p1, p2 = self._poses(pose1, pose2)
         self.counters["screened_edges"] += 1
         if not (self.domain.admits(p1) and self.domain.admits(p2)):
             return False
@@ -453,6 +448,13 @@ class EdgeCertifier:
                 return False
         count = min(MAX_SCREEN_PROBES, int(edge.sweep_speed(self.robot.reach) / step))
         return count == 0 or self._probe(edge, 0.0, 1.0, count)
+
+    def _poses(self, pose1: ArrayLike, pose2: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Both poses as arrays; ``ValueError`` unless each has the robot's pose size."""
+        p1, p2 = np.asarray(pose1, dtype=float), np.asarray(pose2, dtype=float)
+        if p1.shape != p2.shape or p1.size != pose_size(self.n):
+            raise ValueError(f"pose: expected {pose_size(self.n)} numbers per pose")
+        return p1, p2
 
     def _probing(self) -> bool:
         """Whether this edge is probed (the schedule of :data:`PROBE_WARMUP`)."""

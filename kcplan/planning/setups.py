@@ -125,8 +125,7 @@ class RigidSetup(ProblemSetup):
         self.n = n = scenario.dimension
         self.world = world or CollisionWorld(scenario)
         self.robot = self.world.robot
-        thinnest = min(float(b.semi_axes.min()) for b in self.robot.bodies)
-        self.screen_step = RIGID_SCREEN_STEP * thinnest
+        self.screen_step = RIGID_SCREEN_STEP * self.robot.smallest_semi_axis
         self.world.reset_counters()
         self.backend = spec.backend
         self._open(state_space(*scenario.bounds))
