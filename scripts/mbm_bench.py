@@ -189,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
     if unknown or args.per_class < 1 or args.time <= 0:
         parser.error(f"--classes: expected some of {', '.join(MBM_CLASSES)}; --per-class "
                      f"and --time: positive (got {unknown or ''})")  # fmt: skip
-    folder = Path(args.output)
+    folder = Path(args.output).resolve()  # the bench runs from the repository's root
     scenarios = write_scenarios(args, folder / "scenarios")
     files = [path for written, _ in scenarios.values() for path in written]
     rows = run_bench(args, files, folder / "bench") if files else []

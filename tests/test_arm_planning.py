@@ -293,18 +293,22 @@ def test_the_lazy_planner_certifies_every_edge_of_the_path_it_returns():
 
 def test_a_path_the_certificate_rejects_starts_the_planner_again_with_denser_probes():
     """With probes too sparse to see anything (one per 100 rad: the trees check their
-    states only) the planner's first path often crosses the box; the certificate rejects
-    it, the planner starts again with probes twice as dense each time, and the path it
-    finally returns is certified and free. (OMPL is seeded once per process, so the runs
-    are repeated until one meets a rejection: about one in two does.)"""
+    states only) the planner's first path often crosses the box; with repairs off the
+    certificate rejects it, the planner starts again with probes twice as dense each time,
+    and the path it finally returns is certified and free. (OMPL is seeded once per
+    process, so the runs are repeated until one meets a rejection: about one in two
+    does.)"""
     from kcplan.planning.lazy import solve_lazily
     from kcplan.scenarios import load_scenario
 
     scenario = load_scenario(BOX_1)
     setup = _lazy_setup(scenario, seed=4)
     for _ in range(30):
-        outcome = solve_lazily(setup.ss, setup.validator, setup.read, 30.0, screen_step=100.0)
+        outcome = solve_lazily(
+            setup.ss, setup.validator, setup.read, 30.0, screen_step=100.0, repair=False
+        )
         assert outcome.solved and outcome.attempts == outcome.rejected_paths + 1
+        assert outcome.repaired_edges == 0
         if outcome.rejected_paths:
             break
         setup.ss.clear()
@@ -315,3 +319,27 @@ def test_a_path_the_certificate_rejects_starts_the_planner_again_with_denser_pro
     _assert_certified_and_free(scenario, states)
     with pytest.raises(ValueError, match="screen_step"):
         solve_lazily(setup.ss, setup.validator, setup.read, 1.0, screen_step=0.0)
+
+
+def test_a_rejected_edge_is_replaced_by_a_certified_sub_plan():
+    """The same sparse probes with repairs on: an edge the certificate rejects is replaced
+    by a sub-plan between its ends whose edges are certified, and the first attempt's path
+    is returned, certified edge by edge (by a fresh certifier) and free on the meshes."""
+    from kcplan.planning.lazy import solve_lazily
+    from kcplan.scenarios import load_scenario
+
+    scenario = load_scenario(BOX_1)
+    setup = _lazy_setup(scenario, seed=4)
+    for _ in range(30):
+        before = setup.validator.counters["edges"]
+        outcome = solve_lazily(setup.ss, setup.validator, setup.read, 30.0, screen_step=100.0)
+        assert outcome.solved and outcome.attempts == outcome.rejected_paths + 1
+        if outcome.repaired_edges and not outcome.rejected_paths:
+            break
+        setup.ss.clear()
+    assert outcome.attempts == 1 and outcome.repaired_edges >= 1
+    assert outcome.screen_step == 100.0  # not started again
+    states = [setup.read(s) for s in setup.ss.getSolutionPath().getStates()]
+    # the path's edges were certified, and so was every edge the sub-plans' trees grew
+    assert setup.validator.counters["edges"] - before >= len(states) - 1
+    _assert_certified_and_free(scenario, states)

@@ -486,16 +486,26 @@ def test_last_valid_planners_are_refused_with_the_reason(name):
     )
 
 
-@pytest.mark.parametrize("name", ["2d/narrow_corridor", "3d/hand_through_slot"])
-def test_the_lazy_planner_returns_a_certified_rigid_path(name):
-    """kc-rrtconnect-lazy on a rigid robot: the trees' edges screened, only the returned
-    path's edges certified, each of them again by a fresh certifier, and the path free
-    without gaps (verify_path, independent of the certificates)."""
+@pytest.mark.parametrize(
+    ("name", "planner"),
+    [
+        ("2d/narrow_corridor", "kc-rrtconnect-lazy"),
+        ("2d/narrow_corridor", "kc-rrtconnect-lazy-restart"),
+        ("3d/hand_through_slot", "kc-rrtconnect-lazy"),
+    ],
+)
+def test_the_lazy_planner_returns_a_certified_rigid_path(name, planner):
+    """kc-rrtconnect-lazy on a rigid robot (and its ablation that never repairs): the
+    trees' edges screened, only the returned path's edges certified, each of them again by
+    a fresh certifier, and the path free without gaps (verify_path, independent of the
+    certificates)."""
     scenario = load_scenario(ROOT / "scenarios" / f"{name}.yaml")
-    result = plan(scenario, "kc-rrtconnect-lazy", seed=3, time_limit=20.0, simplify=False)
+    result = plan(scenario, planner, seed=3, time_limit=20.0, simplify=False)
     assert result.solved
     c, edges = result.counters, len(result.states) - 1
     assert c["kc_lazy_attempts"] == c["kc_lazy_rejected_paths"] + 1
+    if planner.endswith("-restart"):
+        assert c["kc_lazy_repaired_edges"] == 0
     assert c["kc_screened_edges"] >= edges and c["kc_edges"] <= c["kc_lazy_attempts"] * edges
     fresh = EdgeCertifier(CollisionWorld(scenario))
     states = result.states

@@ -10,13 +10,18 @@ candidate path's edges. :func:`solve_lazily` does that around any single-query p
    distance for an arm, length units of motion for a rigid robot), no proof;
 2. when the planner returns a path, every edge of it is certified as an eager planner's
    would be (the certifier's ``check``: guards, certificates, no gap);
-3. if an edge is rejected (it touches between the probes, or its proof needs more
-   guards than allowed), the planner starts again with the probes twice as dense, within
-   the same time limit.
+3. an edge the certificate rejects (it touches between the probes, or its proof needs
+   more guards than allowed) is *repaired*: RRT-Connect at the planner's range, every
+   edge certified (eager), plans from the edge's start to its end, and its path takes the
+   edge's place. Repairs get as long as the attempt that found the path took
+   (:data:`REPAIR_SHARE`); if one fails, the planner starts again with the probes twice as
+   dense, within the same time limit (so did every rejection before repairs: the
+   ablation ``kc-rrtconnect-lazy-restart``).
 
 So a returned path is certified edge by edge exactly like an eager planner's: laziness
-changes which edges are paid for, never what a returned path is. What it costs: a path
-the certificate rejects throws away the trees grown so far.
+changes which edges are paid for, never what a returned path is. What it costs: the
+screening, and for a rejected edge a short certified plan around it (or, when that fails,
+the trees grown so far).
 """
 
 from __future__ import annotations
@@ -26,10 +31,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ompl import base as ob
+from ompl import geometric as og
 
 from kcplan.planning.arm_certifier import PROBE_STEP
 
-__all__ = ["LAZY_SCREEN_STEP", "RIGID_SCREEN_STEP", "LazyOutcome", "solve_lazily"]
+__all__ = ["LAZY_SCREEN_STEP", "REPAIR_SHARE", "RIGID_SCREEN_STEP", "LazyOutcome", "solve_lazily"]
 
 LAZY_SCREEN_STEP = PROBE_STEP
 """An arm's first screening step, radians of joint-space distance (L2) per probe: the
@@ -46,6 +52,12 @@ slanted_gap and Moving AI's maze-32 (10 runs each): 0.122, 0.051, 0.010, 0.165 s
 0.109, 0.054, 0.011, 0.218 s; a rejected path costs a restart (RESULTS 17.3)."""
 
 
+REPAIR_SHARE = 1.0
+"""Seconds the repairs of one path may take, as a multiple of the seconds the attempt
+that returned it took (its ``solve()`` and certification): a failed repair so costs at
+most what a restart's first attempt would have."""
+
+
 @dataclass(frozen=True)
 class LazyOutcome:
     """What :func:`solve_lazily` did.
@@ -59,9 +71,11 @@ class LazyOutcome:
     attempts : int
         ``solve()`` calls.
     rejected_paths : int
-        Paths returned by the planner that had an edge the certificate rejected.
+        Paths thrown away: a rejected edge that could not be repaired (or repairs off).
     screen_step : float
         The last attempt's screening step.
+    repaired_edges : int
+        Rejected edges replaced by a certified sub-plan, in every attempt.
     """
 
     solved: bool
@@ -69,6 +83,7 @@ class LazyOutcome:
     attempts: int
     rejected_paths: int
     screen_step: float
+    repaired_edges: int = 0
 
 
 def solve_lazily(
@@ -77,6 +92,7 @@ def solve_lazily(
     read: Callable,
     time_limit: float,
     screen_step: float = LAZY_SCREEN_STEP,
+    repair: bool = True,
 ) -> LazyOutcome:
     """Solve ``ss`` screening edges, certifying only the returned path (module docstring).
 
@@ -94,6 +110,9 @@ def solve_lazily(
         The first attempt's screening step (> 0): radians for an arm
         (:data:`LAZY_SCREEN_STEP`), length units for a rigid robot
         (:data:`RIGID_SCREEN_STEP` times its thinnest semi-axis).
+    repair : bool
+        Replace a rejected edge by a certified sub-plan before throwing the trees away;
+        False: restart at once (the ablation).
 
     Returns
     -------
@@ -104,11 +123,12 @@ def solve_lazily(
     if not screen_step > 0.0:
         raise ValueError(f"screen_step: expected a step > 0, got {screen_step}")
     start = time.perf_counter()
-    attempts = rejected = 0
+    attempts = rejected = repaired = 0
     step = screen_step
     certify = validator.certifier.check
     while True:
-        remaining = time_limit - (time.perf_counter() - start)
+        began = time.perf_counter()
+        remaining = time_limit - (began - start)
         if remaining <= 0.0:
             break
         attempts += 1
@@ -120,11 +140,62 @@ def solve_lazily(
         validator.raise_error()
         if not ss.haveExactSolutionPath():
             break
-        path = [read(s) for s in ss.getSolutionPath().getStates()]
-        if all(certify(a, b) for a, b in zip(path, path[1:], strict=False)):
-            return LazyOutcome(True, time.perf_counter() - start, attempts, rejected, step)
+        path = og.PathGeometric(ss.getSolutionPath())  # a copy: the sub-plans start from it
+        q = [read(s) for s in path.getStates()]
+        edges = range(len(q) - 1)
+        if repair:  # every edge: each rejected one is to be repaired
+            bad = [i for i in edges if not certify(q[i], q[i + 1])]
+        else:  # the first rejected edge condemns the path
+            bad = next(([i] for i in edges if not certify(q[i], q[i + 1])), [])
+        if bad and repair:
+            now = time.perf_counter()
+            budget = min(REPAIR_SHARE * (now - began), time_limit - (now - start))
+            fixed = _repaired(ss, path, bad, budget)
+            validator.raise_error()
+            if fixed is not None:
+                pdef = ss.getProblemDefinition()
+                pdef.clearSolutionPaths()
+                pdef.addSolutionPath(fixed, False, 0.0, "kc-lazy-repair")
+                repaired += len(bad)
+                bad = []
+        if not bad:
+            elapsed = time.perf_counter() - start
+            return LazyOutcome(True, elapsed, attempts, rejected, step, repaired)
         rejected += 1
         step *= 0.5
         ss.clear()  # the trees hold screened edges only: start again, probing denser
     ss.clear()
-    return LazyOutcome(False, time.perf_counter() - start, attempts, rejected, step)
+    return LazyOutcome(False, time.perf_counter() - start, attempts, rejected, step, repaired)
+
+
+def _repaired(ss, path, bad: list[int], budget: float):
+    """``path`` with each edge ``i`` of ``bad`` (states i to i + 1) replaced by a path
+    of RRT-Connect at ``ss``'s planner's range whose edges the validator certified, all
+    within ``budget`` seconds; None if one of them is not found in time."""
+    si = ss.getSpaceInformation()
+    planner = ss.getPlanner()
+    reach = planner.getRange() if hasattr(planner, "getRange") else None
+    deadline = time.perf_counter() + budget
+    states = path.getStates()
+    out = og.PathGeometric(si)
+    out.append(states[0])
+    for i in range(len(states) - 1):
+        if i in bad:
+            left = deadline - time.perf_counter()
+            if left <= 0.0:
+                return None
+            pdef = ob.ProblemDefinition(si)
+            pdef.setStartAndGoalStates(states[i], states[i + 1])
+            sub = og.RRTConnect(si)
+            if reach:
+                sub.setRange(reach)
+            sub.setProblemDefinition(pdef)
+            sub.setup()
+            sub.solve(ob.timedPlannerTerminationCondition(left))
+            if not pdef.hasExactSolution():
+                return None
+            between = pdef.getSolutionPath().getStates()
+            for s in between[1:-1]:  # the sub-plan's ends are the edge's
+                out.append(s)
+        out.append(states[i + 1])
+    return out

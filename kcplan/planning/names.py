@@ -66,6 +66,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-paper",
     "kc-prm-paper",
     "kc-rrtconnect-lazy",
+    "kc-rrtconnect-lazy-restart",
     "kc-rrtconnect-wide",
     "kc-rrtconnect-discrete",
     "kc-rrtconnect-noprobe",

@@ -72,6 +72,7 @@ class PlannerSpec:
     arm_certificates: tuple[str, ...] | None = None  # arms (kc): the validator's, if not by kind
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
     lazy: bool = False  # kc: screen the trees' edges, certify the path (planning.lazy)
+    lazy_repair: bool = True  # lazy: a rejected edge replaced by a certified sub-plan
 
     @property
     def kc(self) -> bool:
@@ -92,9 +93,17 @@ PLANNERS: dict[str, PlannerSpec] = {
         og.RRTConnect,
         _KC,
         description="kc-rrtconnect that screens its trees' edges by probes and certifies "
-        "only the path it returns, starting again with denser probes when the certificate "
-        "rejects an edge of it (kcplan.planning.lazy)",
+        "only the path it returns, replacing an edge the certificate rejects by a certified "
+        "sub-plan, or starting again with denser probes (kcplan.planning.lazy)",
         lazy=True,
+    ),
+    "kc-rrtconnect-lazy-restart": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation: kc-rrtconnect-lazy that starts again at once when the "
+        "certificate rejects an edge of its path, without trying to repair it",
+        lazy=True,
+        lazy_repair=False,
     ),
     "kc-rrtconnect-wide": PlannerSpec(
         og.RRTConnect,
@@ -468,7 +477,9 @@ def plan(
     lazy = None
     try:
         if spec.lazy:  # the path certified after solve(); its time counts as the solve's
-            lazy = solve_lazily(ss, validator, setup.read, float(time_limit), setup.screen_step)
+            lazy = solve_lazily(
+                ss, validator, setup.read, float(time_limit), setup.screen_step, spec.lazy_repair
+            )
             solve_time, solved = lazy.time, lazy.solved
         else:
             try:
@@ -516,6 +527,7 @@ def plan(
         if lazy is not None:
             counters["kc_lazy_attempts"] = lazy.attempts
             counters["kc_lazy_rejected_paths"] = lazy.rejected_paths
+            counters["kc_lazy_repaired_edges"] = lazy.repaired_edges
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
             timed = setup.timed(states, velocity_limits, acceleration_limits)
