@@ -153,9 +153,13 @@ def solve_lazily(
             fixed = _repaired(ss, path, bad, budget)
             validator.raise_error()
             if fixed is not None:
-                pdef = ss.getProblemDefinition()
-                pdef.clearSolutionPaths()
-                pdef.addSolutionPath(fixed, False, 0.0, "kc-lazy-repair")
+                # its states copied into the solution ss holds: a path made in Python and
+                # handed to OMPL (addSolutionPath, assign) keeps Python's wrapper of si,
+                # and so ss, alive from inside ss (a cycle the collector cannot see)
+                solution = ss.getSolutionPath()
+                solution.clear()
+                for state in fixed.getStates():
+                    solution.append(state)
                 repaired += len(bad)
                 bad = []
         if not bad:
