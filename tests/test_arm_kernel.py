@@ -359,3 +359,25 @@ def test_the_twins_screen_every_edge_alike_and_screening_proves_nothing(panda, w
         kernel.screen(free[0], free[1], 0.0)
     with pytest.raises(ValueError, match="step"):
         python.screen(free[0], free[1], -1.0)
+
+
+def test_a_check_without_probes_decides_every_edge_as_with_them(panda, world, states):
+    """``check(..., probe=False)`` (a lazy planner's certification of a screened path
+    edge) asks no probe, and its guards alone reach the same decision on every edge as a
+    check with probes: probes only reject early. The twins agree call by call."""
+    free = [q for q in states if not world.in_collision(q)][:30]
+    edges = list(zip(free, free[1:], strict=False))
+    probed = [KernelArmCertifier(world).check(a, b) for a, b in edges]
+    kernel, python = KernelArmCertifier(world), ArmEdgeCertifier(world)
+    bare = []
+    for a, b in edges:
+        k, p = kernel.check(a, b, probe=False), python.check(a, b, probe=False)
+        assert k == p, (a, b)
+        bare.append(k)
+    assert bare == probed and any(bare) and not all(bare)
+    for c in (kernel.counters, python.counters):
+        assert c["probes"] == 0 and c["rejected_probe"] == 0 and c["guards"] > 0
+    obstacles = world.obstacles
+    for (a, b), ok in zip(edges, bare, strict=True):
+        if ok:  # independent of the certificate
+            assert not verify_arm_path(panda, obstacles, [a, b]).collides

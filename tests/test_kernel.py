@@ -1296,3 +1296,23 @@ def test_the_twins_screen_every_edge_alike_and_screening_proves_nothing(world_na
         kernel.screen(*edges[0], 0.0)
     with pytest.raises(ValueError, match="step"):
         python.screen(*edges[0], -1.0)
+
+
+def test_a_rigid_check_without_probes_asks_none_and_stays_sound():
+    """``check(..., probe=False)`` (a lazy planner's certification of a screened path
+    edge) asks no probe in either twin, the twins decide alike (but where coal and FCL
+    see a contact differently: then the edge collides), and every edge it accepts is free
+    without gaps (verify_path, independent of the certificate)."""
+    world = CollisionWorld(_scenario("box_field"))
+    python, kernel = EdgeCertifier(world), KernelCertifier(world)
+    edges = _edges("box_field")[:200]
+    py = np.array([python.check(p1, p2, probe=False) for p1, p2 in edges])
+    kc = np.array([kernel.check(p1, p2, probe=False) for p1, p2 in edges])
+    differ = np.flatnonzero(py != kc)
+    assert len(differ) <= 0.01 * len(edges)
+    assert all(verify_path(world, list(edges[i])).collides for i in differ)
+    assert kc.any() and not kc.all()
+    for c in (python.counters, kernel.counters):
+        assert c["probes"] == 0 and c["rejected_probe"] == 0 and c["guards"] > 0
+    accepted = [list(e) for e, ok in zip(edges, kc, strict=True) if ok]
+    assert not any(verify_path(world, e).collides for e in accepted)

@@ -562,7 +562,7 @@ bool ArmCertifier::check_blend(const double* a, const double* c, const double* b
   return outcome == Advanced::kCovered;
 }
 
-bool ArmCertifier::check(const double* q1, const double* q2) {
+bool ArmCertifier::check(const double* q1, const double* q2, bool with_probes) {
   CertifierCounters& c = counters;
   ++c.edges;
   if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
@@ -581,7 +581,7 @@ bool ArmCertifier::check(const double* q1, const double* q2) {
     hi = 1.0 - radius(*g2, 1.0 - lo);
   }
   if (lo >= hi) return certified_by_endpoints();
-  if (probes_) {
+  if (probes_ && with_probes) {
     double length = 0.0;
     for (int j = 0; j < n_; ++j) length += (q2[j] - q1[j]) * (q2[j] - q1[j]);
     if (!probe(q1, q2, lo, hi, std::sqrt(length))) return reject(c.rejected_probe);

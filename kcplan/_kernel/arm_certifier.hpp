@@ -148,8 +148,10 @@ class ArmCertifier {
   ArmCertifier(const ArmCertifier&) = delete;
   ArmCertifier& operator=(const ArmCertifier&) = delete;
 
-  /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free.
-  bool check(const double* q1, const double* q2);
+  /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free. `with_probes`
+  /// false skips step (4), which only rejects early and proves nothing: for an edge a
+  /// lazy planner has screened already (screen()), whose probes would be asked again.
+  bool check(const double* q1, const double* q2, bool with_probes = true);
   /// Whether the edge q1 -> q2 passes the collision queries check() begins with (both
   /// ends within the limits, q2 valid, no probe over the whole edge in contact: one per
   /// `step` of joint-space distance, radians L2, at most kMaxProbes), and nothing more.

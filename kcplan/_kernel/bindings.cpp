@@ -208,10 +208,10 @@ NB_MODULE(_core, m) {
           nb::keep_alive<1, 2>())
       .def("check",
            [](kcplan::EdgeCertifier& c, const std::vector<double>& p1,
-              const std::vector<double>& p2, double resolution) {
+              const std::vector<double>& p2, double resolution, bool probe) {
              const int n = c.world().robot().dimension();
-             return c.check(pose_of(p1, n), pose_of(p2, n), resolution);
-           }, "pose1"_a, "pose2"_a, "resolution"_a = 0.01)
+             return c.check(pose_of(p1, n), pose_of(p2, n), resolution, probe);
+           }, "pose1"_a, "pose2"_a, "resolution"_a = 0.01, "probe"_a = true)
       .def("check_se2",
            [](kcplan::EdgeCertifier& c, double x1, double y1, double yaw1, double x2, double y2,
               double yaw2, double resolution) {
@@ -432,10 +432,10 @@ NB_MODULE(_core, m) {
           "part_balls"_a = true, "first_order"_a = true, "kc_inflation"_a = 0.0,
           "planes"_a = true, nb::keep_alive<1, 2>())
       .def("check", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
-                       const std::vector<double>& q2) {
+                       const std::vector<double>& q2, bool probe) {
         const kcplan::Chain& chain = c.world().chain();
-        return c.check(joints_of(chain, q1), joints_of(chain, q2));
-      }, "q1"_a, "q2"_a)
+        return c.check(joints_of(chain, q1), joints_of(chain, q2), probe);
+      }, "q1"_a, "q2"_a, "probe"_a = true)
       .def("screen", [](kcplan::ArmCertifier& c, const std::vector<double>& q1,
                         const std::vector<double>& q2, double step) {
         const kcplan::Chain& chain = c.world().chain();

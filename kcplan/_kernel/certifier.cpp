@@ -115,7 +115,7 @@ void EdgeCertifier::require_poses(const Pose& p1, const Pose& p2) const {
                                 " numbers per pose");
 }
 
-bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
+bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution, bool with_probes) {
   CertifierCounters& c = counters;
   ++c.edges;
   require_poses(p1, p2);
@@ -151,7 +151,7 @@ bool EdgeCertifier::check(const Pose& p1, const Pose& p2, double resolution) {
     if (world_.sweep_core_collides(edge.pose(lo).t, edge.pose(hi).t, core_radius_))
       return reject(c.rejected_sweep);
   }
-  if (probing() && !probe(edge, lo, hi, probes_)) return reject(c.rejected_probe);
+  if (with_probes && probing() && !probe(edge, lo, hi, probes_)) return reject(c.rejected_probe);
   if (!g1) {
     g1 = endpoint(p1, k1);
     if (g1->clearance <= 0.0) return reject(c.rejected_guard);

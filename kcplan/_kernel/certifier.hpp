@@ -111,8 +111,11 @@ class EdgeCertifier {
   EdgeCertifier& operator=(const EdgeCertifier&) = delete;
 
   /// Whether the whole edge p1 -> p2 is proven free; `resolution` (in units of s) is the
-  /// step of the discrete fallback.
-  bool check(const Pose& p1, const Pose& p2, double resolution = 0.01);
+  /// step of the discrete fallback. `with_probes` false skips the probes (3), which only
+  /// reject early and prove nothing: for an edge a lazy planner has screened already
+  /// (screen()).
+  bool check(const Pose& p1, const Pose& p2, double resolution = 0.01,
+             bool with_probes = true);
   /// Whether the edge p1 -> p2 passes the cheap tests check() begins with, and nothing
   /// more: both poses in the domain, p2 and the centre path clear of blocked cells, p2
   /// valid, the core capsule clear (sweep_test), and no probe in contact, at most `step`

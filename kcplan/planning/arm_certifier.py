@@ -345,8 +345,12 @@ class ArmEdgeCertifier:
         self.counters[reason] += 1
         return False
 
-    def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
-        """True when the whole edge ``q1 -> q2`` is proven free (see the class docs)."""
+    def check(
+        self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01, probe: bool = True
+    ) -> bool:
+        """True when the whole edge ``q1 -> q2`` is proven free (see the class docs).
+        ``probe=False`` skips the probes, which only reject early and prove nothing: for an
+        edge a lazy planner has screened already (:meth:`screen`)."""
         c = self.counters
         c["edges"] += 1
         q1, q2 = self._joints(state1), self._joints(state2)
@@ -365,7 +369,7 @@ class ArmEdgeCertifier:
             hi = 1.0 - self._radius(g2, terms)
         if lo >= hi:
             return self._certified_by_endpoints()
-        if self.probes and not self._probe(q1, q2, lo, hi, _length(q2 - q1)):
+        if self.probes and probe and not self._probe(q1, q2, lo, hi, _length(q2 - q1)):
             return self._reject("rejected_probe")
         if g1 is None:
             lo = self._radius(self._endpoint(q1), terms)

@@ -359,10 +359,14 @@ class EdgeCertifier:
         self.counters[reason] += 1
         return False
 
-    def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
+    def check(
+        self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01, probe: bool = True
+    ) -> bool:
         """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs); an
         edge with a pose outside :attr:`domain` (not finite, far outside the bounds; see
-        :class:`kcplan.planning.domain.PoseDomain`) is rejected (``rejected_end_state``)."""
+        :class:`kcplan.planning.domain.PoseDomain`) is rejected (``rejected_end_state``).
+        ``probe=False`` skips the probes, which only reject early and prove nothing: for
+        an edge a lazy planner has screened already (:meth:`screen`)."""
         c = self.counters
         c["edges"] += 1
         p1, p2 = self._poses(pose1, pose2)
@@ -399,7 +403,7 @@ class EdgeCertifier:
             c["collision_queries"] += 1
             if self.world.sweep_core_collides(edge.pose(lo), edge.pose(hi), self.core_radius):
                 return self._reject("rejected_sweep")
-        if self._probing() and not self._probe(edge, lo, hi):
+        if probe and self._probing() and not self._probe(edge, lo, hi):
             return self._reject("rejected_probe")
         if g1 is None:
             g1 = self._endpoint(p1, k1)

@@ -126,9 +126,12 @@ class KernelCertifier:
         """Guards in the cache (bounded by ``cache_entries``)."""
         return self._kernel.cache_size
 
-    def check(self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01) -> bool:
-        """True when the whole edge ``pose1 -> pose2`` is proven free."""
-        return self._kernel.check(_flat(pose1), _flat(pose2), float(resolution))
+    def check(
+        self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01, probe: bool = True
+    ) -> bool:
+        """True when the whole edge ``pose1 -> pose2`` is proven free (``probe``: as
+        :meth:`kcplan.planning.certifier.EdgeCertifier.check`)."""
+        return self._kernel.check(_flat(pose1), _flat(pose2), float(resolution), bool(probe))
 
     def state_valid(self, pose: ArrayLike) -> bool:
         """State validity with the cache (one collision query for a pose not seen before)."""
@@ -210,10 +213,13 @@ class KernelArmCertifier:
         self.planes = self.compiled.planes
         self.certificates = arm_certificates(kc_inflation, self.planes)
 
-    def check(self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01) -> bool:
+    def check(
+        self, state1: ArrayLike, state2: ArrayLike, resolution: float = 0.01, probe: bool = True
+    ) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have
-        no discrete fallback)."""
-        return self.compiled.check(_joints(state1), _joints(state2))
+        no discrete fallback; ``probe``: as
+        :meth:`kcplan.planning.arm_certifier.ArmEdgeCertifier.check`)."""
+        return self.compiled.check(_joints(state1), _joints(state2), bool(probe))
 
     def state_valid(self, state: ArrayLike) -> bool:
         """One collision query for a state not seen before (remembered)."""

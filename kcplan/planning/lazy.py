@@ -9,7 +9,8 @@ candidate path's edges. :func:`solve_lazily` does that around any single-query p
    the end state and collision probes every ``screen_step`` (radians of joint-space
    distance for an arm, length units of motion for a rigid robot), no proof;
 2. when the planner returns a path, every edge of it is certified as an eager planner's
-   would be (the certifier's ``check``: guards, certificates, no gap);
+   would be (the certifier's ``check``: guards, certificates, no gap), without the
+   probes ``check`` begins with (they only reject early, and the edge was screened);
 3. an edge the certificate rejects (it touches between the probes, or its proof needs
    more guards than allowed) is *repaired*: RRT-Connect at the planner's range, every
    edge certified (eager), plans from the edge's start to its end, and its path takes the
@@ -93,6 +94,7 @@ def solve_lazily(
     time_limit: float,
     screen_step: float = LAZY_SCREEN_STEP,
     repair: bool = True,
+    probe_path: bool = False,
 ) -> LazyOutcome:
     """Solve ``ss`` screening edges, certifying only the returned path (module docstring).
 
@@ -113,6 +115,9 @@ def solve_lazily(
     repair : bool
         Replace a rejected edge by a certified sub-plan before throwing the trees away;
         False: restart at once (the ablation).
+    probe_path : bool
+        Probe the path's edges again before their guards, as an eager certifier does (the
+        ablation): they were screened at ``screen_step`` already, and probes prove nothing.
 
     Returns
     -------
@@ -125,7 +130,10 @@ def solve_lazily(
     start = time.perf_counter()
     attempts = rejected = repaired = 0
     step = screen_step
-    certify = validator.certifier.check
+    certifier = validator.certifier
+
+    def certify(q1, q2) -> bool:  # screened already: its probes would be asked again
+        return certifier.check(q1, q2, probe=probe_path)
     while True:
         began = time.perf_counter()
         remaining = time_limit - (began - start)
