@@ -134,6 +134,7 @@ def solve_lazily(
 
     def certify(q1, q2) -> bool:  # screened already: its probes would be asked again
         return certifier.check(q1, q2, probe=probe_path)
+
     while True:
         began = time.perf_counter()
         remaining = time_limit - (began - start)
@@ -180,7 +181,7 @@ def solve_lazily(
     return LazyOutcome(False, time.perf_counter() - start, attempts, rejected, step, repaired)
 
 
-def _repaired(ss, path, bad: list[int], budget: float):
+def _repaired(ss, path, bad: list[int], budget: float):  # -> og.PathGeometric | None
     """``path`` with each edge ``i`` of ``bad`` (states i to i + 1) replaced by a path
     of RRT-Connect at ``ss``'s planner's range whose edges the validator certified, all
     within ``budget`` seconds; None if one of them is not found in time."""
@@ -188,6 +189,7 @@ def _repaired(ss, path, bad: list[int], budget: float):
     planner = ss.getPlanner()
     reach = planner.getRange() if hasattr(planner, "getRange") else None
     deadline = time.perf_counter() + budget
+    bad = set(bad)
     states = path.getStates()
     out = og.PathGeometric(si)
     out.append(states[0])
