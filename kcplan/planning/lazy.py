@@ -181,7 +181,7 @@ def solve_lazily(
     return LazyOutcome(False, time.perf_counter() - start, attempts, rejected, step, repaired)
 
 
-def _repaired(ss, path, bad: list[int], budget: float):  # -> og.PathGeometric | None
+def _repaired(ss, path, bad: list[int], budget: float) -> og.PathGeometric | None:
     """``path`` with each edge ``i`` of ``bad`` (states i to i + 1) replaced by a path
     of RRT-Connect at ``ss``'s planner's range whose edges the validator certified, all
     within ``budget`` seconds; None if one of them is not found in time."""
@@ -189,12 +189,12 @@ def _repaired(ss, path, bad: list[int], budget: float):  # -> og.PathGeometric |
     planner = ss.getPlanner()
     reach = planner.getRange() if hasattr(planner, "getRange") else None
     deadline = time.perf_counter() + budget
-    bad = set(bad)
+    rejected = set(bad)
     states = path.getStates()
     out = og.PathGeometric(si)
     out.append(states[0])
     for i in range(len(states) - 1):
-        if i in bad:
+        if i in rejected:
             left = deadline - time.perf_counter()
             if left <= 0.0:
                 return None
