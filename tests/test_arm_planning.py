@@ -291,6 +291,27 @@ def test_the_lazy_planner_certifies_every_edge_of_the_path_it_returns():
     _assert_certified_and_free(scenario, [np.array(q) for q in result.states])
 
 
+def test_an_arm_plans_with_the_lazy_planner_unless_told_otherwise():
+    """plan() and ``kcplan plan`` without a planner: the lazy kc planner for an arm (it
+    measures best there, RESULTS 18.3), the eager one for a rigid robot."""
+    from kcplan.cli import main
+    from kcplan.planning.names import DEFAULT_ARM_PLANNER, DEFAULT_PLANNER, default_planner
+    from kcplan.planning.problem import plan
+    from kcplan.scenarios import load_scenario
+
+    assert (DEFAULT_ARM_PLANNER, DEFAULT_PLANNER) == ("kc-rrtconnect-lazy", "kc-rrtconnect")
+    assert default_planner(True) == DEFAULT_ARM_PLANNER
+    assert default_planner(False) == DEFAULT_PLANNER
+    scenario = load_scenario(BOX_1)
+    result = plan(scenario, seed=2, time_limit=20.0, simplify=False)
+    assert result.solved and result.planner == DEFAULT_ARM_PLANNER
+    assert result.counters["kc_lazy_attempts"] >= 1
+    _assert_certified_and_free(scenario, [np.array(q) for q in result.states])
+    rigid = plan(BOX_1.parents[1] / "2d" / "narrow_corridor.yaml", seed=2, simplify=False)
+    assert rigid.planner == DEFAULT_PLANNER and "kc_lazy_attempts" not in rigid.counters
+    assert main(["plan", str(BOX_1), "--seed", "2", "--no-simplify"]) == 0
+
+
 def test_a_path_the_certificate_rejects_starts_the_planner_again_with_denser_probes():
     """With probes too sparse to see anything (one per 100 rad: the trees check their
     states only) the planner's first path often crosses the box; with repairs off the

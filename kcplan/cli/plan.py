@@ -35,6 +35,10 @@ def run(args: argparse.Namespace) -> int:
     output_file(args.velocity_plot, "--velocity-plot", (".png",))
     scenario = load_input(args.scenario)
     arm = getattr(scenario, "arm", None) is not None
+    if args.planner is None:
+        from kcplan.planning.names import default_planner
+
+        args.planner = default_planner(arm)
     limits = _trajectory_limits(args, scenario, arm)
     if arm and args.guards:
         raise InputError(
@@ -207,7 +211,7 @@ def path_guards(scenario, states) -> list:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Register ``kcplan plan`` on the subcommand parsers ``sub``."""
-    from kcplan.planning.names import PLANNER_NAMES
+    from kcplan.planning.names import DEFAULT_ARM_PLANNER, DEFAULT_PLANNER, PLANNER_NAMES
 
     p = sub.add_parser(
         "plan",
@@ -217,10 +221,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
     p.add_argument(
         "--planner",
-        default="kc-rrtconnect",
+        default=None,
         type=planner_name,
         metavar="PLANNER",
-        help=f"planner (default kc-rrtconnect): {', '.join(PLANNER_NAMES)}",
+        help=f"planner (default {DEFAULT_PLANNER}, for an arm {DEFAULT_ARM_PLANNER}): "
+        f"{', '.join(PLANNER_NAMES)}",
     )
     p.add_argument(
         "--time",

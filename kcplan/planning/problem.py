@@ -29,6 +29,7 @@ from kcplan.planning.names import (
     PLANNER_NAMES,
     STOCK,
     check_planner_name,
+    default_planner,
 )
 from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.setups import setup_for
@@ -367,7 +368,7 @@ class PlanResult:
 
 def plan(
     scenario: Scenario | str | os.PathLike,
-    planner: str = "kc-rrtconnect",
+    planner: str | None = None,
     time_limit: float = 10.0,
     seed: int | None = None,
     simplify: bool = True,
@@ -384,8 +385,10 @@ def plan(
     ----------
     scenario : Scenario or path-like
         A scenario, or the path of a scenario file (:func:`kcplan.scenarios.as_scenario`).
-    planner : str
-        A key of :data:`PLANNERS`.
+    planner : str, optional
+        A key of :data:`PLANNERS`; default
+        :func:`~kcplan.planning.names.default_planner` of the robot's kind
+        (``kc-rrtconnect``, and ``kc-rrtconnect-lazy`` for an arm).
     time_limit : float
         Seconds for ``solve()``; simplification has its own budget of the same length.
     seed : int, optional
@@ -425,12 +428,15 @@ def plan(
         like the planner's edges).
     """
     try:
-        check_planner_name(planner)
+        if planner is not None:
+            check_planner_name(planner)
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     scenario = as_scenario(scenario)
+    arm = isinstance(scenario, ArmScenario)
+    planner = planner or default_planner(arm)
     try:  # the arm-only planners refuse a rigid robot
-        check_planner_name(planner, arm=isinstance(scenario, ArmScenario))
+        check_planner_name(planner, arm=arm)
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     spec = PLANNERS[planner]
