@@ -149,13 +149,14 @@ def solve_lazily(
         validator.raise_error()
         if not ss.haveExactSolutionPath():
             break
-        path = og.PathGeometric(ss.getSolutionPath())  # a copy: the sub-plans start from it
+        path = ss.getSolutionPath()
         q = [read(s) for s in path.getStates()]
-        edges = range(len(q) - 1)
-        if repair:  # every edge: each rejected one is to be repaired
-            bad = [i for i in edges if not certify(q[i], q[i + 1])]
-        else:  # the first rejected edge condemns the path
-            bad = next(([i] for i in edges if not certify(q[i], q[i + 1])), [])
+        bad = []
+        for i in range(len(q) - 1):
+            if not certify(q[i], q[i + 1]):
+                bad.append(i)
+                if not repair:  # the first rejected edge condemns the path
+                    break
         if bad and repair:
             now = time.perf_counter()
             budget = min(REPAIR_SHARE * (now - began), time_limit - (now - start))
@@ -165,10 +166,9 @@ def solve_lazily(
                 # its states copied into the solution ss holds: a path made in Python and
                 # handed to OMPL (addSolutionPath, assign) keeps Python's wrapper of si,
                 # and so ss, alive from inside ss (a cycle the collector cannot see)
-                solution = ss.getSolutionPath()
-                solution.clear()
+                path.clear()
                 for state in fixed.getStates():
-                    solution.append(state)
+                    path.append(state)
                 repaired += len(bad)
                 bad = []
         if not bad:
