@@ -14,7 +14,7 @@ from kcplan.arm import ArmWorld
 from kcplan.arm.verify import ArmMeshChecker, verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.certifier import COUNTER_NAMES
-from kcplan.planning.states import joint_space, set_joint_state
+from kcplan.planning.states import joint_reader, joint_space, joint_state, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
 
 READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
@@ -28,6 +28,19 @@ def panda():
 @pytest.fixture(scope="module")
 def scene(panda):
     return ArmWorld(panda, arm_obstacles()), arm_obstacles()
+
+
+@pytest.mark.parametrize("dof", [1, 2, 7])
+def test_joint_reader_reads_every_joint_as_a_tuple(dof):
+    """What the validator hands the kernel for an OMPL state: a tuple of the joints, in
+    order (one joint too: itemgetter of one index alone would return a bare float)."""
+    values = np.linspace(-1.0, 1.0, dof) + 0.25
+    space = joint_space(-2.0 * np.ones(dof), 2.0 * np.ones(dof))
+    state = space.allocState()
+    set_joint_state(state, values)
+    read = joint_reader(dof)(state)
+    assert isinstance(read, tuple) and read == tuple(values)
+    np.testing.assert_array_equal(joint_state(state, dof), values)
 
 
 def test_the_arm_counters_are_the_rigid_certifiers():

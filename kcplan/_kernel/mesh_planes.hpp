@@ -40,31 +40,41 @@ struct ShapeSupport {
     out.centre = tf.getTranslation();
     out.capsule = false;
     out.hull = nullptr;
-    if (const auto* e = dynamic_cast<const coal::Ellipsoid*>(g)) {
-      out.M = e->radii.asDiagonal() * tf.getRotation().transpose();
-      out.spread_low = e->radii.minCoeff(), out.spread_high = e->radii.maxCoeff();
-      return true;
-    }
-    if (const auto* s = dynamic_cast<const coal::Sphere*>(g)) {
-      out.M = s->radius * tf.getRotation().transpose();
-      out.spread_low = out.spread_high = s->radius;
-      return true;
-    }
-    if (const auto* c = dynamic_cast<const coal::Capsule*>(g)) {
-      out.capsule = true;
-      out.half_segment = tf.getRotation().col(2) * c->halfLength;
-      out.radius = c->radius;
-      out.spread_low = c->radius, out.spread_high = c->radius + c->halfLength;
-      return true;
-    }
-    if (const auto* h = dynamic_cast<const coal::ConvexBase*>(g)) {
-      // |v| <= |aabb centre| + the local box's half diagonal (coal's aabb_radius), so
-      // |h(n) - n . c| <= that bound whatever the frame's origin is
-      out.hull = h->points.get();
-      out.rotation = tf.getRotation();
-      out.spread_high = (h->aabb_center.norm() + h->aabb_radius) * (1.0 + 1e-12);
-      out.spread_low = -out.spread_high;
-      return true;
+    // by coal's node type, not dynamic_cast: this runs for every broad-phase candidate,
+    // and a failed cross-library dynamic_cast compares type names
+    switch (g == nullptr ? coal::BV_UNKNOWN : g->getNodeType()) {
+      case coal::GEOM_ELLIPSOID: {
+        const auto* e = static_cast<const coal::Ellipsoid*>(g);
+        out.M = e->radii.asDiagonal() * tf.getRotation().transpose();
+        out.spread_low = e->radii.minCoeff(), out.spread_high = e->radii.maxCoeff();
+        return true;
+      }
+      case coal::GEOM_SPHERE: {
+        const auto* s = static_cast<const coal::Sphere*>(g);
+        out.M = s->radius * tf.getRotation().transpose();
+        out.spread_low = out.spread_high = s->radius;
+        return true;
+      }
+      case coal::GEOM_CAPSULE: {
+        const auto* c = static_cast<const coal::Capsule*>(g);
+        out.capsule = true;
+        out.half_segment = tf.getRotation().col(2) * c->halfLength;
+        out.radius = c->radius;
+        out.spread_low = c->radius, out.spread_high = c->radius + c->halfLength;
+        return true;
+      }
+      case coal::GEOM_CONVEX: {  // every coal::ConvexBase, and nothing else
+        const auto* h = static_cast<const coal::ConvexBase*>(g);
+        // |v| <= |aabb centre| + the local box's half diagonal (coal's aabb_radius), so
+        // |h(n) - n . c| <= that bound whatever the frame's origin is
+        out.hull = h->points.get();
+        out.rotation = tf.getRotation();
+        out.spread_high = (h->aabb_center.norm() + h->aabb_radius) * (1.0 + 1e-12);
+        out.spread_low = -out.spread_high;
+        return true;
+      }
+      default:
+        break;
     }
     return false;
   }

@@ -192,14 +192,17 @@ class ConvexLowerBound:
         alphas = (1.0, float(np.cos(theta)))
         gammas = (1.0, float(np.sin(theta) / theta)) if theta > 0 else (1.0,)
 
+        corners = list(product(alphas, gammas))
+        alpha = np.array([al for al, _ in corners])
+        gamma = np.array([ga for _, ga in corners])
+
         def test(X: NDArray) -> NDArray:
-            worst = np.full(X.shape[0], -np.inf)
-            for alpha, gamma in product(alphas, gammas):
-                Y = X.copy()
-                Y[:, :r] *= gamma
-                value = linearised_margin(a, b, np.full(X.shape[0], alpha), Y)
-                worst = np.maximum(worst, value + (1.0 - alpha) * kappa)
-            return worst
+            # every corner's points in one stack: one SVD and one secular solve per call
+            k = X.shape[0]
+            Y = np.tile(X, (len(corners), 1))
+            Y[:, :r] *= np.repeat(gamma, k)[:, None]
+            value = linearised_margin(a, b, np.repeat(alpha, k), Y).reshape(len(corners), k)
+            return (value + ((1.0 - alpha) * kappa)[:, None]).max(axis=0)
 
         return test
 

@@ -33,6 +33,7 @@ from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.lazy import LAZY_SCREEN_STEP, RIGID_SCREEN_STEP
 from kcplan.planning.names import ARM_RANGE, RIGID_RANGE
 from kcplan.planning.states import (
+    joint_reader,
     joint_space,
     joint_state,
     set_joint_state,
@@ -202,9 +203,10 @@ class ArmSetup(ProblemSetup):
             self.state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
         elif spec.backend == "kernel":
             kernel, admits = self.world.kernel, self.world.kernel.chain.admits
+            joints = joint_reader(n)  # as the kc validator reads them: a fair comparison
 
             def state_valid(state) -> bool:
-                q = [state[j] for j in range(n)]
+                q = joints(state)
                 return admits(q) and not kernel.in_collision(q)
 
             self.state_valid = state_valid

