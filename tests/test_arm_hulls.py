@@ -112,6 +112,28 @@ def test_the_pandas_links_are_their_meshes_hulls(panda):
         np.testing.assert_array_equal(body.semi_axes, [body.hull.radius] * 3)
 
 
+@settings(max_examples=80, deadline=None)
+@given(
+    st.integers(0, 10),
+    arrays(np.float64, (3,), elements=st.floats(-1e3, 1e3)),
+)
+@example(6, np.array([0.0, 0.0, 1.0]))
+@example(6, np.array([0.0, 0.0, 0.0]))
+def test_the_kernels_hull_support_is_the_largest_vertex_product(panda, k, n):
+    """The kernel's vectorised support of a link's hull (VertexSupport) is max_v n . v over
+    every vertex, the one the primitive bounds, the pairs' gaps and the plane reaches rest
+    on: never below any vertex's product (a support too small would make them unsound)."""
+    chain = ArmWorld(panda, ()).kernel.chain
+    vertices = panda.bodies[k].hull.vertices
+    products = vertices @ n
+    h = chain.hull_support(k, n.tolist())
+    scale = 1e-15 * (1.0 + np.abs(vertices).sum(axis=1).max() * np.abs(n).max())
+    assert products.max() - scale <= h <= products.max() + scale
+    assert (vertices @ n <= h + scale).all()
+    with pytest.raises(ValueError, match="hull_support: expected the index of a body"):
+        chain.hull_support(len(panda.bodies), n.tolist())
+
+
 def test_the_kernel_holds_a_hull_to_its_ellipsoid(panda):
     """A hull that sticks out of the ellipsoid its speed bounds are for is refused."""
     chain = _core.Chain  # the arguments of kcplan._kernel.kernel_chain, one body

@@ -305,6 +305,12 @@ NB_MODULE(_core, m) {
         for (const kcplan::ChainBody& b : c.bodies()) n += b.hull != nullptr;
         return n;
       })
+      .def("hull_support", [](const kcplan::Chain& c, std::size_t k, const std::array<double, 3>& n) {
+        if (k >= c.bodies().size() || !c.bodies()[k].hull)
+          throw std::invalid_argument("hull_support: expected the index of a body with a hull");
+        return c.bodies()[k].hull->support(coal::Vec3s(n[0], n[1], n[2]));
+      }, "k"_a, "n"_a, "max over body k's hull vertices v (its own frame) of n . v "
+      "(kcplan/_kernel/convex_body.hpp VertexSupport)")
       .def_prop_ro("point_speeds", &kcplan::Chain::point_speeds)
       .def_prop_ro("carries", &kcplan::Chain::carries)
       .def("relative_speeds", &kcplan::Chain::relative_speeds, "pairs"_a)

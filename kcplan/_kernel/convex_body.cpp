@@ -32,22 +32,37 @@ std::shared_ptr<coal::ConvexBase> make_convex(const std::vector<double>& vertice
         throw std::invalid_argument(name + ": triangle index out of range");
     faces->emplace_back(triangles[i], triangles[i + 1], triangles[i + 2]);
   }
-  auto shape = std::make_shared<coal::Convex<coal::Triangle>>(
+  auto shape = std::make_shared<SupportedConvex>(
       points, static_cast<unsigned int>(m), faces, static_cast<unsigned int>(faces->size()));
   shape->computeLocalAABB();
   return shape;
 }
 
+VertexSupport::VertexSupport(const std::vector<coal::Vec3s>& points)
+    : x_(static_cast<Eigen::Index>(points.size())),
+      y_(static_cast<Eigen::Index>(points.size())),
+      z_(static_cast<Eigen::Index>(points.size())) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    x_[k] = points[i][0], y_[k] = points[i][1], z_[k] = points[i][2];
+  }
+}
+
+SupportedConvex::SupportedConvex(std::shared_ptr<std::vector<coal::Vec3s>> points,
+                                 unsigned int num_points,
+                                 std::shared_ptr<std::vector<coal::Triangle>> faces,
+                                 unsigned int num_faces)
+    : coal::Convex<coal::Triangle>(points, num_points, faces, num_faces), support_(*points) {
+  user_data = this;  // the mark of() looks for
+}
+
 BodyHull::BodyHull(const std::vector<double>& vertices, const std::vector<int>& triangles)
-    : shape_(make_convex(vertices, triangles, "hull")) {
+    : shape_(make_convex(vertices, triangles, "hull")),
+      support_(SupportedConvex::of(*shape_)) {
   for (const coal::Vec3s& v : *shape_->points) radius_ = std::max(radius_, v.norm());
   radius_ *= 1.0 + 1e-12;  // rounding: the ball must hold every vertex
 }
 
-double BodyHull::support(const coal::Vec3s& n) const {
-  double h = -std::numeric_limits<double>::infinity();
-  for (const coal::Vec3s& v : *shape_->points) h = std::max(h, n.dot(v));
-  return h;
-}
+double BodyHull::support(const coal::Vec3s& n) const { return (*support_)(n); }
 
 }  // namespace kcplan

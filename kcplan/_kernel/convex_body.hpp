@@ -6,13 +6,50 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Core>
 #include <coal/math/transform.h>
 #include <coal/shape/convex.h>
 
 namespace kcplan {
 
+/// The support function of a finite point set, h(n) = max_i n . v_i, exactly (every
+/// vertex is looked at) in one vectorised pass over the coordinates stored as three
+/// arrays: the arm's collision and clearance queries ask it for every obstacle near a
+/// hull and every self pair whose balls meet (Primitive::separation, the pairs' gaps).
+class VertexSupport {
+ public:
+  explicit VertexSupport(const std::vector<coal::Vec3s>& points);
+  /// h(n) for n of any length; -inf for no points.
+  double operator()(const coal::Vec3s& n) const {
+    return (x_ * n[0] + y_ * n[1] + z_ * n[2]).maxCoeff();
+  }
+
+ private:
+  Eigen::ArrayXd x_, y_, z_;
+};
+
+/// coal's Convex with its vertices' VertexSupport: what make_convex builds. It marks
+/// itself in CollisionGeometry::user_data (pointing to itself), so that a support query
+/// given only the coal geometry can tell it from any other ConvexBase (a copy made by
+/// coal's clone() is a plain Convex whose mark points elsewhere): `of(geometry)`.
+class SupportedConvex : public coal::Convex<coal::Triangle> {
+ public:
+  SupportedConvex(std::shared_ptr<std::vector<coal::Vec3s>> points, unsigned int num_points,
+                  std::shared_ptr<std::vector<coal::Triangle>> faces, unsigned int num_faces);
+  const VertexSupport& support() const { return support_; }
+  /// The VertexSupport of `geometry` if it is a SupportedConvex, else null.
+  static const VertexSupport* of(const coal::CollisionGeometry& geometry) {
+    return geometry.user_data == &geometry
+               ? &static_cast<const SupportedConvex&>(geometry).support_
+               : nullptr;
+  }
+
+ private:
+  VertexSupport support_;
+};
+
 /// A convex polytope from m x 3 vertices and t x 3 triangle indices (flat): coal's
-/// Convex, whose vertex neighbours (filled from the triangles) let GJK hill-climb.
+/// Convex (a SupportedConvex), whose vertex neighbours (filled from the triangles) let GJK hill-climb.
 /// Throws std::invalid_argument for fewer than 4 vertices or triangles, an index out of
 /// range or a coordinate that is not finite; `what` names the input in the message.
 std::shared_ptr<coal::ConvexBase> make_convex(const std::vector<double>& vertices,
@@ -38,6 +75,7 @@ class BodyHull {
 
  private:
   std::shared_ptr<coal::ConvexBase> shape_;
+  const VertexSupport* support_;  // shape_'s
   double radius_ = 0.0;
 };
 

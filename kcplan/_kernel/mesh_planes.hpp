@@ -16,6 +16,8 @@
 #include <coal/shape/convex.h>
 #include <coal/shape/geometric_shapes.h>
 
+#include "convex_body.hpp"
+
 namespace kcplan {
 
 /// The support function h(n) = max over a robot-side shape of n . x: an ellipsoid
@@ -30,6 +32,7 @@ struct ShapeSupport {
   double radius = 0.0;                             // capsule: rho
   bool capsule = false;
   const std::vector<coal::Vec3s>* hull = nullptr;  // polytope: its vertices v
+  const VertexSupport* hull_support = nullptr;       // and their support, if it has one
   coal::Matrix3s rotation = coal::Matrix3s::Identity();  // polytope: R
   double spread_low = 0.0, spread_high = 0.0;
 
@@ -40,6 +43,7 @@ struct ShapeSupport {
     out.centre = tf.getTranslation();
     out.capsule = false;
     out.hull = nullptr;
+    out.hull_support = nullptr;
     // by coal's node type, not dynamic_cast: this runs for every broad-phase candidate,
     // and a failed cross-library dynamic_cast compares type names
     switch (g == nullptr ? coal::BV_UNKNOWN : g->getNodeType()) {
@@ -68,6 +72,7 @@ struct ShapeSupport {
         // |v| <= |aabb centre| + the local box's half diagonal (coal's aabb_radius), so
         // |h(n) - n . c| <= that bound whatever the frame's origin is
         out.hull = h->points.get();
+        out.hull_support = SupportedConvex::of(*h);
         out.rotation = tf.getRotation();
         out.spread_high = (h->aabb_center.norm() + h->aabb_radius) * (1.0 + 1e-12);
         out.spread_low = -out.spread_high;
@@ -81,6 +86,7 @@ struct ShapeSupport {
 
   /// h(n) - n . c.
   double spread(const coal::Vec3s& n) const {
+    if (hull_support != nullptr) return (*hull_support)(rotation.transpose() * n);
     if (hull != nullptr) return (*hull)[extreme_vertex(n)].dot(rotation.transpose() * n);
     return capsule ? std::abs(n.dot(half_segment)) + radius : (M * n).norm();
   }
