@@ -305,7 +305,8 @@ NB_MODULE(_core, m) {
         for (const kcplan::ChainBody& b : c.bodies()) n += b.hull != nullptr;
         return n;
       })
-      .def("hull_support", [](const kcplan::Chain& c, std::size_t k, const std::array<double, 3>& n) {
+      .def("hull_support",
+           [](const kcplan::Chain& c, std::size_t k, const std::array<double, 3>& n) {
         if (k >= c.bodies().size() || !c.bodies()[k].hull)
           throw std::invalid_argument("hull_support: expected the index of a body with a hull");
         return c.bodies()[k].hull->support(coal::Vec3s(n[0], n[1], n[2]));

@@ -1,7 +1,7 @@
 #include "convex_body.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 

@@ -18,8 +18,9 @@ namespace kcplan {
 /// hull and every self pair whose balls meet (Primitive::separation, the pairs' gaps).
 class VertexSupport {
  public:
+  /// `points`: at least one (make_convex asks for four).
   explicit VertexSupport(const std::vector<coal::Vec3s>& points);
-  /// h(n) for n of any length; -inf for no points.
+  /// h(n), for n of any length.
   double operator()(const coal::Vec3s& n) const {
     return (x_ * n[0] + y_ * n[1] + z_ * n[2]).maxCoeff();
   }
@@ -36,7 +37,6 @@ class SupportedConvex : public coal::Convex<coal::Triangle> {
  public:
   SupportedConvex(std::shared_ptr<std::vector<coal::Vec3s>> points, unsigned int num_points,
                   std::shared_ptr<std::vector<coal::Triangle>> faces, unsigned int num_faces);
-  const VertexSupport& support() const { return support_; }
   /// The VertexSupport of `geometry` if it is a SupportedConvex, else null.
   static const VertexSupport* of(const coal::CollisionGeometry& geometry) {
     return geometry.user_data == &geometry
@@ -48,8 +48,8 @@ class SupportedConvex : public coal::Convex<coal::Triangle> {
   VertexSupport support_;
 };
 
-/// A convex polytope from m x 3 vertices and t x 3 triangle indices (flat): coal's
-/// Convex (a SupportedConvex), whose vertex neighbours (filled from the triangles) let GJK hill-climb.
+/// A convex polytope from m x 3 vertices and t x 3 triangle indices (flat): a
+/// SupportedConvex, whose vertex neighbours (filled from the triangles) let GJK hill-climb.
 /// Throws std::invalid_argument for fewer than 4 vertices or triangles, an index out of
 /// range or a coordinate that is not finite; `what` names the input in the message.
 std::shared_ptr<coal::ConvexBase> make_convex(const std::vector<double>& vertices,
