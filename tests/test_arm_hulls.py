@@ -128,8 +128,7 @@ def test_the_kernels_hull_support_is_the_largest_vertex_product(panda, k, n):
     products = vertices @ n
     h = chain.hull_support(k, n.tolist())
     scale = 1e-15 * (1.0 + np.abs(vertices).sum(axis=1).max() * np.abs(n).max())
-    assert products.max() - scale <= h <= products.max() + scale
-    assert (vertices @ n <= h + scale).all()
+    assert products.max() - scale <= h <= products.max() + scale  # so no product exceeds h
     with pytest.raises(ValueError, match="hull_support: expected the index of a body"):
         chain.hull_support(len(panda.bodies), n.tolist())
 
