@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
         run_campaign,
     )
     from kcplan.bench.report import prepare_output, write_reports
-    from kcplan.planning.names import check_planner_name
+    from kcplan.planning.names import check_planner_for, check_planner_name
 
     planners = [p.strip() for p in args.planners.split(",") if p.strip()]
     if not planners:
@@ -41,10 +41,10 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as err:
             raise InputError(f"kcplan bench: --planners: {err}") from None
     scenarios = [load_input(path) for path in args.scenarios]
-    for scenario in scenarios:  # arm-only planners refuse a rigid robot up front
+    for scenario in scenarios:  # planners that refuse the scenario's robot, up front
         for name in planners:
             try:
-                check_planner_name(name, arm=getattr(scenario, "arm", None) is not None)
+                check_planner_for(name, scenario)
             except ValueError as err:
                 raise InputError(f"{scenario.source}: --planners: {err}") from None
     names = [s.name for s in scenarios]

@@ -55,11 +55,11 @@ def run(args: argparse.Namespace) -> int:
         reason = visual_meshes_missing(scenario.arm)
         if reason:
             raise InputError(f"{args.scenario}: --meshes visual: {reason}")
-    from kcplan.planning.names import check_planner_name
+    from kcplan.planning.names import check_planner_for
     from kcplan.planning.problem import plan
 
-    try:  # an arm-only planner on a rigid robot: one line, exit 2
-        check_planner_name(args.planner, arm=arm)
+    try:  # an arm-only planner on a rigid robot, the paper's on several bodies: one line, exit 2
+        check_planner_for(args.planner, scenario)
     except ValueError as err:
         raise InputError(f"{args.scenario}: --planner: {err}") from None
     velocity, acceleration = limits if limits is not None else (None, None)

@@ -58,6 +58,14 @@ ARM_ONLY = {
 }
 """Planners for arms only, with what they are (the reason a rigid robot is refused)."""
 
+SINGLE_ELLIPSOID_ONLY = {
+    "kc-rrtconnect-paper": "kc-rrtconnect with the paper's KC polytope only",
+    "kc-prm-paper": "kc-prm with the paper's KC polytope only",
+}
+"""Planners whose certificate is the paper's polytope, which holds for one ellipsoid centred
+at the robot's origin (``E_a``) only, with what they are (the reason another robot is
+refused)."""
+
 PLANNER_NAMES = (
     "kc-rrtconnect",
     "kc-prm",
@@ -117,15 +125,31 @@ def default_planner(arm: bool) -> str:
     return DEFAULT_ARM_PLANNER if arm else DEFAULT_PLANNER
 
 
-def check_planner_name(name: str, arm: bool | None = None) -> str:
+def check_planner_name(name: str, arm: bool | None = None, single: bool | None = None) -> str:
     """``name`` if it is a planner; otherwise ``ValueError`` with one line saying why.
 
     ``arm=False`` (a rigid robot's scenario) also refuses the planners of
-    :data:`ARM_ONLY`; None checks the name alone."""
+    :data:`ARM_ONLY`; ``single=False`` (a robot other than one ellipsoid centred at its
+    origin, :attr:`kcplan.geometry.robot.Robot.is_single`) those of
+    :data:`SINGLE_ELLIPSOID_ONLY`; None checks the name alone."""
     if name in REFUSED_PLANNERS:
         raise ValueError(f"{name}: refused: {REFUSED_PLANNERS[name]}")
     if name not in PLANNER_NAMES:
         raise ValueError(f"expected a planner name ({', '.join(PLANNER_NAMES)}), got {name!r}")
     if arm is False and name in ARM_ONLY:
         raise ValueError(f"{name}: for arms only: {ARM_ONLY[name]}; this robot is rigid")
+    if single is False and name in SINGLE_ELLIPSOID_ONLY:
+        raise ValueError(
+            f"{name}: {SINGLE_ELLIPSOID_ONLY[name]}, which needs one ellipsoid centred at the "
+            "robot's origin; this robot is not (use the kc-* planners)"
+        )
     return name
+
+
+def check_planner_for(name: str, scenario) -> str:
+    """:func:`check_planner_name` for the robot of ``scenario`` (an arm's, with ``arm``
+    set, or a rigid robot's ``Scenario``): the arm-only planners refuse a rigid robot, the
+    paper's any robot but one ellipsoid centred at its origin."""
+    arm = getattr(scenario, "arm", None) is not None
+    return check_planner_name(name, arm=arm, single=None if arm else scenario.robot.is_single)
+

@@ -28,6 +28,7 @@ from kcplan.planning.names import (
     OMPL_RANGE,
     PLANNER_NAMES,
     STOCK,
+    check_planner_for,
     check_planner_name,
     default_planner,
 )
@@ -435,8 +436,8 @@ def plan(
     scenario = as_scenario(scenario)
     arm = isinstance(scenario, ArmScenario)
     planner = planner or default_planner(arm)
-    try:  # the arm-only planners refuse a rigid robot
-        check_planner_name(planner, arm=arm)
+    try:  # the arm-only planners refuse a rigid robot, the paper's any robot but E_a
+        check_planner_for(planner, scenario)
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     spec = PLANNERS[planner]
