@@ -111,3 +111,24 @@ FRAME_B = [
 ]
 AXES_A = [0.037072799508, 0.065385681018, 0.082023441791]
 AXES_B = [0.007962846033, 0.016329866169, 0.028091109846]
+
+
+def assert_planner_refused(scenario, name: str, line: str, why: str, tmp_path, capsys) -> None:
+    """The planner ``name`` refused on ``scenario`` everywhere a user can ask for it:
+    `kcplan plan` prints exactly ``line`` and exits 2, `kcplan bench` exits 2 naming it
+    (``--planners: NAME: WHY``) and writes nothing, and ``plan()`` raises a ValueError
+    that starts ``planner: NAME: WHY``."""
+    import re
+
+    from kcplan.cli import main
+    from kcplan.planning.problem import plan
+
+    assert main(["plan", str(scenario), "--planner", name, "--time", "0.05"]) == 2
+    assert capsys.readouterr().err.strip() == line
+    argv = ["bench", str(scenario), "--planners", f"kc-rrtconnect,{name}", "--runs", "1",
+            "-o", str(tmp_path / "bench")]  # fmt: skip
+    assert main(argv) == 2
+    assert f"--planners: {name}: {why}" in capsys.readouterr().err
+    assert not (tmp_path / "bench").exists()
+    with pytest.raises(ValueError, match=f"^{re.escape(f'planner: {name}: {why}')}"):
+        plan(scenario, name, time_limit=0.05)

@@ -9,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import assert_planner_refused
 
 from kcplan.arm.world import ArmWorld
 from kcplan.cli import main
 from kcplan.planning.names import ARM_ONLY, JOINT_STEP
 from kcplan.planning.pin_checker import PinChecker
-from kcplan.planning.problem import PLANNERS, plan
+from kcplan.planning.problem import PLANNERS
 from kcplan.planning.setups import ArmSetup
 from kcplan.scenarios import load_scenario
 
@@ -118,18 +119,9 @@ def test_rrtconnect_pin_plans_table_pick_1(tmp_path, capsys):
 
 @pytest.mark.parametrize("name", sorted(ARM_ONLY))
 def test_arm_only_planners_refuse_a_rigid_robot_with_one_line(name, tmp_path, capsys):
-    assert main(["plan", str(CORRIDOR), "--planner", name]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == (
-        f"{CORRIDOR}: --planner: {name}: for arms only: {ARM_ONLY[name]}; this robot is rigid"
-    )
-    argv = ["bench", str(CORRIDOR), "--planners", f"rrtconnect,{name}", "--runs", "1",
-            "-o", str(tmp_path / "bench")]  # fmt: skip
-    assert main(argv) == 2
-    assert f"--planners: {name}: for arms only" in capsys.readouterr().err
-    assert not (tmp_path / "bench").exists()
-    with pytest.raises(ValueError, match=f"^planner: {name}: for arms only: "):
-        plan(CORRIDOR, name, time_limit=0.1)
+    why = f"for arms only: {ARM_ONLY[name]}"
+    line = f"{CORRIDOR}: --planner: {name}: {why}; this robot is rigid"
+    assert_planner_refused(CORRIDOR, name, line, why, tmp_path, capsys)
 
 
 @pytest.mark.parametrize("name", ["rrtconnect-32", "prm-32"])

@@ -6,16 +6,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import assert_planner_refused
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from kcplan.cli import main
 from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.names import SINGLE_ELLIPSOID_ONLY
-from kcplan.planning.problem import PLANNERS, plan
+from kcplan.planning.problem import PLANNERS
 from kcplan.planning.verify import verify_path
 from kcplan.scenarios import dump_scenario, load_scenario, parse_scenario
 from kcplan.world import CollisionWorld, ScenarioError
@@ -199,18 +199,12 @@ def test_the_paper_planners_refuse_several_bodies_with_one_line(name, tmp_path, 
     `kcplan bench` (nothing written), a ValueError from plan(), never a traceback
     (test_cli_fuzz found it)."""
     door = Path(__file__).parent.parent / "scenarios" / "2d" / "l_robot_door.yaml"
-    assert main(["plan", str(door), "--planner", name, "--time", "0.05"]) == 2
-    assert capsys.readouterr().err.strip() == (
-        f"{door}: --planner: {name}: {SINGLE_ELLIPSOID_ONLY[name]}, which needs one ellipsoid "
-        "centred at the robot's origin; this robot is not (use the kc-* planners)"
+    why = SINGLE_ELLIPSOID_ONLY[name]
+    line = (
+        f"{door}: --planner: {name}: {why}, which needs one ellipsoid centred at the "
+        "robot's origin; this robot is not (use the kc-* planners)"
     )
-    argv = ["bench", str(door), "--planners", f"kc-rrtconnect,{name}", "--runs", "1",
-            "-o", str(tmp_path / "bench")]  # fmt: skip
-    assert main(argv) == 2
-    assert f"--planners: {name}: {SINGLE_ELLIPSOID_ONLY[name]}" in capsys.readouterr().err
-    assert not (tmp_path / "bench").exists()
-    with pytest.raises(ValueError, match=f"^planner: {name}: .* needs one ellipsoid centred"):
-        plan(door, name, time_limit=0.05)
+    assert_planner_refused(door, name, line, why, tmp_path, capsys)
 
 
 def test_region_beats_the_ball_along_a_wall_with_two_bodies():
