@@ -295,6 +295,30 @@ def test_part_balls_decide_every_edge_as_every_pair_does(panda, world, states):
     assert g["rejected"] > 0 and g["certified_by_endpoints"] + g["certified_one_guard"] > 0
 
 
+def test_the_guard_cache_saves_guards_and_changes_no_decision(panda, world, states):
+    """kc-rrtconnect-nocache's certifier (``guard_cache=False``: one guard and one state
+    check remembered) decides every edge of a star of edges, asked twice, as the default
+    one, which measures fewer guards: the edges that share a state share its guard. (The
+    Python twin gets the same one-entry cache.)"""
+    from kcplan.planning.certifiers import certifier_for
+
+    twin = certifier_for(panda, world, "python", guard_cache=False)
+    assert twin.cache.max_entries == 1
+    assert certifier_for(panda, world, "python").cache.max_entries > 100_000
+    free = [q for q in states if not world.in_collision(q)][:25]
+    cached = certifier_for(panda, world, "kernel")
+    once = certifier_for(panda, world, "kernel", guard_cache=False)
+    hub = free[0]
+    for _ in range(2):
+        for q in free[1:]:
+            for end in (hub + 0.3 * (q - hub), q):
+                assert cached.check(hub, end) == once.check(hub, end)
+    c, o = cached.counters, once.counters
+    assert c["rejected"] == o["rejected"] > 0 and c["edges"] - c["rejected"] > 0
+    assert c["guards"] < o["guards"] and c["endpoint_guards"] < o["endpoint_guards"]
+    assert c["cached_guards"] > o["cached_guards"]
+
+
 def test_a_self_colliding_end_is_not_remembered_as_valid(panda):
     """Pairs are measured lazily, but an end guard at a self-colliding state still
     rejects its edge and leaves the state invalid in the cache."""

@@ -44,7 +44,10 @@ RIGID_OPTIONS = (
     "probes", "learn_schedule",
 )  # fmt: skip
 """The options of a rigid robot's certifier (:func:`certifier_for`)."""
-ARM_OPTIONS = ("certificates", "inflations", "max_guards", "probes", "part_balls", "first_order")
+ARM_OPTIONS = (
+    "certificates", "inflations", "max_guards", "probes", "part_balls", "first_order",
+    "guard_cache",
+)  # fmt: skip
 """The options of an arm's certifier (:func:`certifier_for`)."""
 
 Certifier = EdgeCertifier | KernelCertifier | ArmEdgeCertifier | KernelArmCertifier
@@ -111,6 +114,10 @@ def certifier_for(robot, world, backend: str | None = None, **options) -> Certif
             their bodies (the same decisions; False is the ablation).
         first_order : bool
             Bound each body's motion by its twist at a guard as well (False: ablation).
+        guard_cache : bool
+            Remember every state's guard and validity across edges (default); False
+            remembers one of each (the ablation: an edge's end guards measured again at
+            every edge that shares the state).
 
     Raises
     ------
@@ -182,6 +189,7 @@ def _arm_certifier(
     probes: int = DEFAULT_PROBES,
     part_balls: bool = True,
     first_order: bool = True,
+    guard_cache: bool = True,
 ) -> ArmEdgeCertifier | KernelArmCertifier:
     if arm is not world.arm:
         raise ValueError("robot: an ArmWorld certifies its own arm; got another robot")
@@ -202,12 +210,13 @@ def _arm_certifier(
         if not (math.isfinite(kc_inflation) and kc_inflation > 0.0):
             raise ValueError(f"inflations: expected a KC inflation > 0, got {inflations!r}")
     planes = "region" in chosen
+    cache = {} if guard_cache else {"cache_entries": 1}
     if backend == "kernel":
         return KernelArmCertifier(
             world, max_guards, probes=probes > 0, part_balls=part_balls,
-            first_order=first_order, kc_inflation=kc_inflation, planes=planes,
+            first_order=first_order, kc_inflation=kc_inflation, planes=planes, **cache,
         )  # fmt: skip
     return ArmEdgeCertifier(
         world, max_guards, probes=probes > 0, first_order=first_order,
-        kc_inflation=kc_inflation, planes=planes,
+        kc_inflation=kc_inflation, planes=planes, **cache,
     )  # fmt: skip

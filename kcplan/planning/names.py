@@ -82,6 +82,7 @@ PLANNER_NAMES = (
     "kc-rrtconnect-learnall",
     "kc-rrtconnect-noparts",
     "kc-rrtconnect-nofirst",
+    "kc-rrtconnect-nocache",
     "kc-rrtconnect-noplanes",
     "kc-prm-noprobe",
     "kc-rrtconnect-py",

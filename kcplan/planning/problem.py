@@ -71,6 +71,7 @@ class PlannerSpec:
     joint_step: float | None = None  # arms (stock): largest checked step, rad of L2 distance
     part_balls: bool = True  # arms (kc, kernel): far groups of self pairs decided at once
     first_order: bool = True  # arms (kc): the bodies' twist at a guard bounds them as well
+    guard_cache: bool = True  # arms (kc): guards and state checks remembered across edges
     arm_certificates: tuple[str, ...] | None = None  # arms (kc): the validator's, if not by kind
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
     lazy: bool = False  # kc: screen the trees' edges, certify the path (planning.lazy)
@@ -166,6 +167,14 @@ PLANNERS: dict[str, PlannerSpec] = {
         "pair, without the links' balls that decide far groups of pairs at once (the "
         "world's state checks, every planner's, use those balls either way)",
         part_balls=False,
+    ),
+    "kc-rrtconnect-nocache": PlannerSpec(
+        og.RRTConnect,
+        _KC,
+        description="ablation (arms): kc-rrtconnect whose certifier remembers one guard and "
+        "one state check, not every state's across edges (an edge's end guards are "
+        "measured again at every edge that shares the state)",
+        guard_cache=False,
     ),
     "kc-rrtconnect-noplanes": PlannerSpec(
         og.RRTConnect,

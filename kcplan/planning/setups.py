@@ -193,7 +193,7 @@ class ArmSetup(ProblemSetup):
                 self.si, arm, self.world, certificates=certificates,
                 inflations=[scenario.inflation] if scenario.inflation > 0 else None,
                 backend=spec.backend, probes=spec.probes, part_balls=spec.part_balls,
-                first_order=spec.first_order,
+                first_order=spec.first_order, guard_cache=spec.guard_cache,
             )  # fmt: skip
             self.si.setMotionValidator(self.validator)
             self.state_valid = self.validator.state_valid
