@@ -34,6 +34,7 @@ from kcplan.cover.bodies import body_holds, body_rotation
 from kcplan.cover.cache import cache_folder, cached_cover
 from kcplan.cover.partition import Piece, clip_simplices
 from kcplan.cover.profiles import PROFILES
+from kcplan.geometry import enclosing
 from kcplan.geometry.enclosing import (
     ellipsoid_axes,
     ellipsoid_volume,
@@ -162,6 +163,30 @@ def test_mvee_volume_is_near_optimal():
     exact = ellipsoid_volume(enclose(P, *minimum_volume_ellipsoid(P, tol=1e-9)))
     rough = ellipsoid_volume(enclose(P, *minimum_volume_ellipsoid(P, tol=1e-2)))
     assert exact <= rough <= exact * (1 + 1e-2) ** 1.5 * (1 + 1e-6)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(2, 3),
+    st.integers(6, 300),
+    st.sampled_from([1e-1, 1e-2, 1e-4, 1e-7]),
+    st.integers(0, 2**31),
+)
+def test_mvee_stops_on_its_tolerance_despite_rank_one_updates(n, m, tol, seed):
+    """The iteration updates ``V(u)^-1`` and ``g`` by rank one (Sherman and Morrison) and
+    must still stop only where every fresh ``g_i <= (n + 1)(1 + tol)``: with ``M =
+    S^-1 / n`` that is ``(x - c)^T M (x - c) <= 1 + tol (n + 1) / n`` for every point.
+    And it takes the textbook iteration's steps: with ``REFRESH = 0`` (a new inverse
+    every step) the same ellipsoid comes out."""
+    rng = np.random.default_rng(seed)
+    P = rng.normal(size=(m, n)) * rng.uniform(0.05, 1.0, n) + rng.normal(size=n)
+    c, M = minimum_volume_ellipsoid(P, tol=tol)
+    assert mahalanobis_sq(P, c, M).max() <= 1.0 + tol * (n + 1) / n + 1e-9
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(enclosing, "REFRESH", 0)
+        c0, M0 = minimum_volume_ellipsoid(P, tol=tol)
+    np.testing.assert_allclose(c, c0, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(M, M0, rtol=1e-8, atol=1e-9 * np.abs(M0).max())
 
 
 # ---------------------------------------------------------------- winding numbers, clipping

@@ -8,7 +8,9 @@ semi-axes are ``1 / sqrt(eig(M))`` along the eigenvectors of ``M``.
 volume enclosing ellipsoid (MVEE; Khachiyan, "Rounding of polytopes in the real number
 model of computation", Math. Oper. Res. 21, 1996; in the form of Todd and Yildirim, "On
 Khachiyan's algorithm for the computation of minimum-volume enclosing ellipsoids",
-Discrete Appl. Math. 155, 2007, with their away steps and Kumar and Yildirim's start).
+Discrete Appl. Math. 155, 2007, with their away steps and Kumar and Yildirim's start;
+each step changes ``V(u) = Q diag(u) Q^T`` by rank one, so its inverse and every
+``g_i = q_i^T V(u)^-1 q_i`` follow by Sherman and Morrison's formula in O(m n)).
 It is an *approximation*: the ellipsoid it returns need
 not contain every point. :func:`enclose` makes containment exact by scaling about the
 centre, which is what a sound cover needs; the approximation then only costs volume, at
@@ -29,6 +31,11 @@ __all__ = [
     "mahalanobis_sq",
     "minimum_volume_ellipsoid",
 ]
+
+REFRESH = 64
+"""Khachiyan's iteration updates ``V(u)^-1`` and every ``g`` by rank one per step and
+computes them afresh after this many steps, and before it stops (the stopping test is on
+fresh values)."""
 
 FLAT_RATIO = 1e-6
 """Point sets whose thinnest principal spread is below this fraction of the widest are
@@ -127,22 +134,40 @@ def minimum_volume_ellipsoid(
     u[np.unique(np.concatenate([X.argmin(axis=0), X.argmax(axis=0)]))] = 1.0
     u = 0.9 * u / u.sum() + 0.1 / len(X)  # every point keeps weight: V starts regular
     d = n + 1
+    V_inv = np.linalg.inv((Q * u) @ Q.T)
+    g = np.einsum("im,im->m", Q, V_inv @ Q)  # g_i = q_i^T V(u)^-1 q_i
+    fresh = 0  # rank-one updates since g was computed afresh
     for _ in range(max_iterations):
-        g = np.einsum("im,im->m", Q, np.linalg.inv((Q * u) @ Q.T) @ Q)
-        j = int(np.argmax(g))
-        k = int(np.argmin(np.where(u > 0, g, np.inf)))
+        j = int(g.argmax())
+        k = int(np.where(u > 0, g, np.inf).argmin())
         grow, shrink = g[j] / d - 1.0, 1.0 - g[k] / d
         if grow <= tol:
-            break
-        if grow >= shrink:  # Khachiyan's step towards the worst point
-            step = (g[j] - d) / (d * (g[j] - 1.0))
+            if fresh == 0:
+                break
+            fresh = REFRESH  # the test on updated g: confirm it on g computed afresh
+        elif grow >= shrink:  # Khachiyan's step towards the worst point
+            i, step = j, (g[j] - d) / (d * (g[j] - 1.0))
             u *= 1.0 - step
             u[j] += step
         else:  # Todd and Yildirim's away step from the weakest support point
-            step = min((d - g[k]) / (d * (g[k] - 1.0)), u[k] / (1.0 - u[k]))
-            u *= 1.0 + step
-            u[k] -= step
+            i = k
+            step = -min((d - g[k]) / (d * (g[k] - 1.0)), u[k] / (1.0 - u[k]))
+            u *= 1.0 - step
+            u[k] += step
             u[k] = max(u[k], 0.0)
+        if fresh >= REFRESH:  # bound the updates' rounding drift
+            V_inv = np.linalg.inv((Q * u) @ Q.T)
+            g = np.einsum("im,im->m", Q, V_inv @ Q)
+            fresh = 0
+            continue
+        # V(u) became (1 - step) V + step q_i q_i^T: Sherman and Morrison's update of its
+        # inverse and of every g, O(m n) instead of a new inverse and O(m n^2)
+        w = V_inv @ Q[:, i]
+        h = w @ Q  # q_l^T V^-1 q_i for every l
+        scale = step / (1.0 - step + step * g[i])
+        V_inv = (V_inv - (scale * w)[:, None] * w) / (1.0 - step)
+        g = (g - scale * h * h) / (1.0 - step)
+        fresh += 1
     c = X.T @ u
     S = (X.T * u) @ X - np.outer(c, c)
     try:
