@@ -136,10 +136,13 @@ def minimum_volume_ellipsoid(
     d = n + 1
     V_inv = np.linalg.inv((Q * u) @ Q.T)
     g = np.einsum("im,im->m", Q, V_inv @ Q)  # g_i = q_i^T V(u)^-1 q_i
+    rows = np.ascontiguousarray(Q.T)  # the lifted points as rows, (m, n + 1)
+    barred = np.zeros(len(X))  # +inf where u_l = 0: no away step from those
+    below = np.empty(len(X))
     fresh = 0  # rank-one updates since g was computed afresh
     for _ in range(max_iterations):
         j = int(g.argmax())
-        k = int(np.where(u > 0, g, np.inf).argmin())
+        k = int(np.add(g, barred, out=below).argmin())
         grow, shrink = g[j] / d - 1.0, 1.0 - g[k] / d
         if grow <= tol:
             if fresh == 0:
@@ -154,7 +157,8 @@ def minimum_volume_ellipsoid(
             step = -min((d - g[k]) / (d * (g[k] - 1.0)), u[k] / (1.0 - u[k]))
             u *= 1.0 - step
             u[k] += step
-            u[k] = max(u[k], 0.0)
+            if u[k] <= 0.0:  # dropped from the support
+                u[k], barred[k] = 0.0, np.inf
         if fresh >= REFRESH:  # bound the updates' rounding drift
             V_inv = np.linalg.inv((Q * u) @ Q.T)
             g = np.einsum("im,im->m", Q, V_inv @ Q)
@@ -162,11 +166,15 @@ def minimum_volume_ellipsoid(
             continue
         # V(u) became (1 - step) V + step q_i q_i^T: Sherman and Morrison's update of its
         # inverse and of every g, O(m n) instead of a new inverse and O(m n^2)
-        w = V_inv @ Q[:, i]
-        h = w @ Q  # q_l^T V^-1 q_i for every l
+        w = V_inv @ rows[i]
+        h = rows @ w  # q_l^T V^-1 q_i for every l
         scale = step / (1.0 - step + step * g[i])
-        V_inv = (V_inv - (scale * w)[:, None] * w) / (1.0 - step)
-        g = (g - scale * h * h) / (1.0 - step)
+        keep = 1.0 / (1.0 - step)
+        V_inv = (V_inv - (scale * w)[:, None] * w) * keep
+        h *= h
+        h *= scale
+        g -= h
+        g *= keep
         fresh += 1
     c = X.T @ u
     S = (X.T * u) @ X - np.outer(c, c)
