@@ -55,6 +55,12 @@ def _same_suite(_out: str, tmp: Path) -> None:
         assert (tmp / rel).read_text() == (ROOT / "scenarios" / rel).read_text(), rel
 
 
+def _same_covers(out: str, _tmp: Path) -> None:
+    """Khachiyan's rank-one updates take the textbook iteration's steps: the same covers."""
+    rows = re.findall(r"^\| (\S+) \| \d+ \| .* \| ([\d.]+) \| ([\d.]+) \|$", out, re.M)
+    assert rows and all(textbook == rank_one for _, textbook, rank_one in rows), rows
+
+
 def _no_violation(out: str, _tmp: Path, names=tuple(CERTIFICATE_SETS)) -> None:
     rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 100 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
     assert {(n, name) for n, name, *_ in rows} == {
@@ -125,6 +131,16 @@ CASES = [
             rf"^\| meshes/rock\.stl x16 \| 320 \| 1 \| {NUMBER} \|$",
         ),
         ("cover.md", "cover.csv", "cover.png"),
+    ),
+    Case(
+        "fit_time.py",
+        ("--meshes", "scenarios/3d/meshes/l_bracket.stl", "--profiles", "", "--bodies", "2"),
+        (
+            rf"^\| meshes/l_bracket\.stl \| 2 \| {NUMBER} \| {NUMBER} \| {NUMBER} "
+            rf"\| {NUMBER} \| {NUMBER} \|$",
+            rf"^\| all \| \| {NUMBER} \| {NUMBER} \| {NUMBER} \| \| \|$",
+        ),
+        check=_same_covers,
     ),
     Case(
         "mbm_validity.py",
