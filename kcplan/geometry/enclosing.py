@@ -37,6 +37,10 @@ REFRESH = 64
 computes them afresh after this many steps, and before it stops (the stopping test is on
 fresh values)."""
 
+TIE = 1e-9
+"""Values of ``g`` within this share of the largest (smallest) tie for Khachiyan's step
+towards (away from) a point: the first of them is taken."""
+
 FLAT_RATIO = 1e-6
 """Point sets whose thinnest principal spread is below this fraction of the widest are
 treated as flat (Khachiyan's iteration needs a full-dimensional set)."""
@@ -141,8 +145,14 @@ def minimum_volume_ellipsoid(
     below = np.empty(len(X))
     fresh = 0  # rank-one updates since g was computed afresh
     for _ in range(max_iterations):
-        j = int(g.argmax())
-        k = int(np.add(g, barred, out=below).argmin())
+        # the first of near ties (within TIE of the extreme): the steps then do not
+        # depend on rounding, of the updates or of the platform (symmetric parts, such
+        # as a pipe's rings of vertices, tie everywhere)
+        top = g.max()
+        j = int((g >= top - TIE * abs(top)).argmax())
+        np.add(g, barred, out=below)
+        low = below.min()
+        k = int((below <= low + TIE * abs(low)).argmax())
         grow, shrink = g[j] / d - 1.0, 1.0 - g[k] / d
         if grow <= tol:
             if fresh == 0:
