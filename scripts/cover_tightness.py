@@ -161,15 +161,29 @@ def plot(rows: list[dict], path: Path) -> None:
     save_figure(fig, path)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_part_options(parser: argparse.ArgumentParser, bodies: str, meaning: str) -> None:
+    """The options that choose the parts and the numbers of bodies: ``--meshes``,
+    ``--profiles`` and ``--bodies`` (default ``bodies``, described as ``meaning``)."""
     parser.add_argument("--meshes", nargs="+", type=Path, help="meshes (default: see above)")
     parser.add_argument(
         "--profiles",
         default=",".join(PROFILES),
         help=f"generated parts, comma-separated, or '' (default {','.join(PROFILES)})",
     )
-    parser.add_argument("--bodies", default="1,2,3,4,5,6,7,8", help="K values (default 1..8)")
+    parser.add_argument("--bodies", default=bodies, help=f"K values (default {meaning})")
+
+
+def chosen_parts(args: argparse.Namespace, folder: Path) -> tuple[list[Path], list[int]]:
+    """The meshes :func:`add_part_options` chose, the generated parts written into
+    ``folder`` after them, and the numbers of bodies."""
+    paths = args.meshes or [p for p in DEFAULT_MESHES if p.is_file()]
+    paths += write_profiles([n for n in args.profiles.split(",") if n], folder)
+    return paths, [int(k) for k in args.bodies.split(",")]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_part_options(parser, "1,2,3,4,5,6,7,8", "1..8")
     parser.add_argument("--samples", type=int, default=400_000, help="Monte Carlo samples")
     parser.add_argument("--timing", default="4,8", help="K values for the fit-time runs, or ''")
     parser.add_argument(
@@ -181,10 +195,8 @@ def main() -> None:
     )
     parser.add_argument("--out", type=Path, help="folder for cover.md, cover.csv, cover.png")
     args = parser.parse_args()
-    paths = args.meshes or [p for p in DEFAULT_MESHES if p.is_file()]
-    bodies = [int(k) for k in args.bodies.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
-        paths += write_profiles([n for n in args.profiles.split(",") if n], Path(tmp))
+        paths, bodies = chosen_parts(args, Path(tmp))
         rows = tightness(paths, bodies, args.samples)
         big = args.timing_mesh if args.timing_mesh.is_file() else paths[0]
         timing = fit_times(big, [int(k) for k in args.timing.split(",") if k])

@@ -24,11 +24,10 @@ import time
 from pathlib import Path
 
 from kcplan.cover import fit_cover, read_solid, union_volume
-from kcplan.cover.profiles import PROFILES
 from kcplan.geometry import enclosing
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cover_tightness import DEFAULT_MESHES, label, write_profiles  # noqa: E402
+from cover_tightness import add_part_options, chosen_parts, label  # noqa: E402
 
 
 def fit(path: Path, bodies: int, refresh: int) -> tuple[float, float]:
@@ -47,23 +46,15 @@ def fit(path: Path, bodies: int, refresh: int) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--meshes", nargs="+", type=Path, help="meshes (default: see above)")
-    parser.add_argument(
-        "--profiles",
-        default=",".join(PROFILES),
-        help=f"generated parts, comma-separated, or '' (default {','.join(PROFILES)})",
-    )
-    parser.add_argument("--bodies", default="4,8", help="K values (default 4,8)")
+    add_part_options(parser, "4,8", "4,8")
     args = parser.parse_args()
-    paths = args.meshes or [p for p in DEFAULT_MESHES if p.is_file()]
-    bodies = [int(k) for k in args.bodies.split(",")]
     lines = [
         "| mesh | K | textbook: s | rank-one: s | ratio | union / part, textbook | rank-one |",
         "|---|---|---|---|---|---|---|",
     ]
     total = [0.0, 0.0]
     with tempfile.TemporaryDirectory() as tmp:
-        paths += write_profiles([n for n in args.profiles.split(",") if n], Path(tmp))
+        paths, bodies = chosen_parts(args, Path(tmp))
         for path in paths:
             for k in bodies:
                 (t0, v0), (t1, v1) = fit(path, k, 0), fit(path, k, enclosing.REFRESH)
