@@ -175,11 +175,13 @@ def test_mvee_volume_is_near_optimal():
 def test_mvee_stops_on_its_tolerance_despite_rank_one_updates(n, m, tol, seed):
     """The iteration updates ``V(u)^-1`` and ``g`` by rank one (Sherman and Morrison) and
     must still stop only where every fresh ``g_i <= (n + 1)(1 + tol)``: with ``M =
-    S^-1 / n`` that is ``(x - c)^T M (x - c) <= 1 + tol (n + 1) / n`` for every point.
-    And it takes the textbook iteration's steps: with ``REFRESH = 0`` (a new inverse
-    every step) the same ellipsoid comes out."""
+    S^-1 / n`` that is ``(x - c)^T M (x - c) <= 1 + tol (n + 1) / n`` for every point,
+    within the iteration limit even at ``tol = 1e-7`` on clouds a thousand times thinner
+    one way (a point dropped from the support and chosen again must be able to leave it
+    again, or the iteration crawls). And it takes the textbook iteration's steps: with
+    ``REFRESH = 0`` (a new inverse every step) the same ellipsoid comes out."""
     rng = np.random.default_rng(seed)
-    P = rng.normal(size=(m, n)) * rng.uniform(0.05, 1.0, n) + rng.normal(size=n)
+    P = rng.normal(size=(m, n)) * 10 ** rng.uniform(-3, 0, n) + rng.normal(size=n)
     c, M = minimum_volume_ellipsoid(P, tol=tol)
     assert mahalanobis_sq(P, c, M).max() <= 1.0 + tol * (n + 1) / n + 1e-9
     with pytest.MonkeyPatch.context() as patch:
@@ -187,6 +189,18 @@ def test_mvee_stops_on_its_tolerance_despite_rank_one_updates(n, m, tol, seed):
         c0, M0 = minimum_volume_ellipsoid(P, tol=tol)
     np.testing.assert_allclose(c, c0, rtol=1e-8, atol=1e-9)
     np.testing.assert_allclose(M, M0, rtol=1e-8, atol=1e-9 * np.abs(M0).max())
+
+
+@pytest.mark.parametrize("seed", [28, 140, 161])
+def test_mvee_converges_on_a_thin_cloud_at_a_tight_tolerance(seed):
+    """A point dropped from the support by an away step and chosen again by a step
+    towards it must be able to leave again: when it could not (a bug of this session's
+    first in-place loop) these clouds, a thousand times thinner one way, ended the
+    iteration limit 1e-5 to 1e-4 above ``1 + tol (n + 1) / n``."""
+    rng = np.random.default_rng(seed)
+    P = rng.normal(size=(300, 3)) * 10 ** rng.uniform(-3, 0, 3)
+    c, M = minimum_volume_ellipsoid(P, tol=1e-7)
+    assert mahalanobis_sq(P, c, M).max() <= 1.0 + 1e-7 * 4 / 3 + 1e-9
 
 
 def test_a_pipes_cover_takes_the_textbook_steps(tmp_path):

@@ -162,6 +162,7 @@ def minimum_volume_ellipsoid(
             i, step = j, (g[j] - d) / (d * (g[j] - 1.0))
             u *= 1.0 - step
             u[j] += step
+            barred[j] = 0.0  # back in the support, if it had been dropped
         else:  # Todd and Yildirim's away step from the weakest support point
             i = k
             step = -min((d - g[k]) / (d * (g[k] - 1.0)), u[k] / (1.0 - u[k]))
