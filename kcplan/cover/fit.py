@@ -660,29 +660,31 @@ def _fit_offset(
     meter = OffsetMeter(solid, min(solid.size / 100.0, 0.5 * tol))
     search = _Search(solid, shape, pencils=False)
     leaves = [search.root]
-    bounds: dict[int, tuple[Body, object]] = {}  # id(leaf) -> (its body, its offset bound)
+    # leaf -> (its body, its offset bound); keyed by the leaf itself (hashed by identity),
+    # not id(leaf): a cut leaf's id may be given to a new child once the leaf is freed
+    bounds: dict[_Leaf, tuple[Body, object]] = {}
     note = ""
     while True:
         for leaf in leaves:
-            if id(leaf) not in bounds:
+            if leaf not in bounds:
                 body = _sound_body(leaf, shape, solid.weld)
-                bounds[id(leaf)] = (body, meter.bound(body, tol, below=max_offset))
-        over = [k for k, leaf in enumerate(leaves) if bounds[id(leaf)][1].high > max_offset]
+                bounds[leaf] = (body, meter.bound(body, tol, below=max_offset))
+        over = [k for k, leaf in enumerate(leaves) if bounds[leaf][1].high > max_offset]
         if not over:
             break
         if len(leaves) >= most:
             for leaf in (leaves[k] for k in over):  # the value, not just "above"
-                body = bounds[id(leaf)][0]
+                body = bounds[leaf][0]
                 # to a tenth of the value: a tight bound of a large offset costs minutes
-                coarse = max(tol, 0.1 * bounds[id(leaf)][1].low)
-                bounds[id(leaf)] = (body, meter.bound(body, coarse))
-            worst = max(bounds[id(leaf)][1].high for leaf in leaves)
+                coarse = max(tol, 0.1 * bounds[leaf][1].low)
+                bounds[leaf] = (body, meter.bound(body, coarse))
+            worst = max(bounds[leaf][1].high for leaf in leaves)
             note = (
                 f"stopped at {most} bodies, the most asked for: {len(over)} still stick out "
                 f"by more than {max_offset:.4g} (up to {worst:.4g})"
             )
             break
-        k = max(over, key=lambda j: meter.estimate(bounds[id(leaves[j])][0]))
+        k = max(over, key=lambda j: meter.estimate(bounds[leaves[j]][0]))
         normal, offset = _offset_cut(search, meter, leaves[k], shape)
         leaf = leaves.pop(k)
         children = search.children(leaf, normal, offset)
@@ -694,10 +696,10 @@ def _fit_offset(
     out = []
     for k, leaf in enumerate(leaves):
         leaf.node["body"] = k
-        out.append(bounds[id(leaf)][0])
+        out.append(bounds[leaf][0])
     worst = max(body_holds(body, leaf.points) for body, leaf in zip(out, leaves, strict=True))
     # measured from the welded solid; the file's triangles are within solid.weld of it
-    offset_high = max(bounds[id(leaf)][1].high for leaf in leaves) + solid.weld
+    offset_high = max(bounds[leaf][1].high for leaf in leaves) + solid.weld
     seconds = time.perf_counter() - start
     return Cover(solid, tuple(out), search.root.node, shape, seconds, note, worst, offset_high)
 
