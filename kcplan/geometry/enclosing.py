@@ -138,8 +138,12 @@ def minimum_volume_ellipsoid(
     u[np.unique(np.concatenate([X.argmin(axis=0), X.argmax(axis=0)]))] = 1.0
     u = 0.9 * u / u.sum() + 0.1 / len(X)  # every point keeps weight: V starts regular
     d = n + 1
-    V_inv = np.linalg.inv((Q * u) @ Q.T)
-    g = np.einsum("im,im->m", Q, V_inv @ Q)  # g_i = q_i^T V(u)^-1 q_i
+
+    def fresh_values() -> tuple[NDArray, NDArray]:  # V(u)^-1 and g_i = q_i^T V(u)^-1 q_i
+        V_inv = np.linalg.inv((Q * u) @ Q.T)
+        return V_inv, np.einsum("im,im->m", Q, V_inv @ Q)
+
+    V_inv, g = fresh_values()
     rows = np.ascontiguousarray(Q.T)  # the lifted points as rows, (m, n + 1)
     barred = np.zeros(len(X))  # +inf where u_l = 0: no away step from those
     below = np.empty(len(X))
@@ -171,8 +175,7 @@ def minimum_volume_ellipsoid(
             if u[k] <= 0.0:  # dropped from the support
                 u[k], barred[k] = 0.0, np.inf
         if fresh >= REFRESH:  # bound the updates' rounding drift
-            V_inv = np.linalg.inv((Q * u) @ Q.T)
-            g = np.einsum("im,im->m", Q, V_inv @ Q)
+            V_inv, g = fresh_values()
             fresh = 0
             continue
         # V(u) became (1 - step) V + step q_i q_i^T: Sherman and Morrison's update of its
