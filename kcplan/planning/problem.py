@@ -412,8 +412,10 @@ def plan(
         Reuse a collision world (its counters are reset).
     first_solution : bool
         Stop at the first exact solution: the optimization objective's cost threshold is
-        set to infinity, so asymptotically optimal planners (RRT*, BIT*, ...) report their
-        time to a first solution instead of running to the time limit.
+        set to infinity and the planner stops once the problem has an exact solution, so
+        asymptotically optimal planners (RRT*, BIT*, AORRTC, ...) report their time to a
+        first solution instead of running to the time limit. PRM* still runs to the limit:
+        it hands its path to the problem only when it stops.
     progress : float, optional
         Record the best cost every ``progress`` seconds while solving (planners for which
         :func:`kcplan.planning.progress.reports_progress` holds: RRT*, Informed RRT*,
@@ -490,6 +492,10 @@ def plan(
         stop = recorder.termination_condition(float(time_limit))
     else:
         stop = ob.timedPlannerTerminationCondition(float(time_limit))
+    if first_solution:  # AORRTC does not stop at a met cost threshold
+        stop = ob.plannerOrTerminationCondition(
+            stop, ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition())
+        )
     lazy = None
     try:
         if spec.lazy:  # the path certified after solve(); its time counts as the solve's
