@@ -89,7 +89,8 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
     rng = np.random.default_rng(args.seed)
     folder = Path(args.mbm) / args.robot
     t0 = time.perf_counter()
-    problems = load_mbm_archive(folder / "problems.tar.bz2")
+    keys = [(c, i) for c in MBM_CLASSES for i in range(1, args.per_class + 1)]
+    problems = load_mbm_archive(folder / "problems.tar.bz2", keys)
     chosen = [
         problems[c, i]
         for i in range(1, args.per_class + 1)

@@ -67,7 +67,8 @@ def write_scenarios(args: argparse.Namespace, folder: Path) -> dict[str, list]:
     """Step 1: the scenarios of the chosen problems in ``folder``; per class the written
     files and the problems invalid for the cover (``(index, "start"|"goal"|"both")``)."""
     urdf, srdf = ROBOTS[args.robot]
-    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2")
+    keys = [(c, i) for c in args.classes for i in range(1, args.per_class + 1)]
+    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2", keys)
     folder.mkdir(parents=True, exist_ok=True)
     out: dict[str, list] = {}
     arms: dict = {}

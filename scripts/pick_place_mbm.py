@@ -222,7 +222,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("-o", "--output", default="pick-place-mbm")
     args = p.parse_args(argv)
     start = time.perf_counter()
-    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2")
+    keys = [("table_pick", i) for i in range(1, args.problems + 1)]
+    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2", keys)
     folder = Path(args.output) / "scenarios"
     folder.mkdir(parents=True, exist_ok=True)
     runs = []

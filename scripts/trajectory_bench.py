@@ -90,7 +90,8 @@ def run(args: argparse.Namespace) -> list[dict]:
     import toppra  # noqa: F401  (imported once here, not inside the first timing)
 
     urdf, srdf = ROBOTS[args.robot]
-    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2")
+    keys = [(c, i) for c in args.classes for i in range(1, args.per_class + 1)]
+    problems = load_mbm_archive(Path(args.mbm) / args.robot / "problems.tar.bz2", keys)
     folder = Path(args.output) / "scenarios"
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(args.seed)

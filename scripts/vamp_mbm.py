@@ -77,7 +77,7 @@ def read_problems(archive: str, per_class: int) -> list[dict]:
 
     if tuple(MBM_CLASSES) != CLASSES:
         raise RuntimeError(f"expected the classes {CLASSES}, kcplan has {MBM_CLASSES}")
-    problems = load_mbm_archive(archive)
+    problems = load_mbm_archive(archive, [(c, i) for c in CLASSES for i in range(1, per_class + 1)])
     out = []
     for problem_class in CLASSES:
         for index in range(1, per_class + 1):
@@ -188,7 +188,7 @@ def verify_paths(archive: str, results: list[dict], robot: str = "panda") -> lis
     from kcplan.arm.mbm import load_mbm_archive
     from kcplan.arm.verify import verify_arm_path
 
-    problems = load_mbm_archive(archive)
+    problems = load_mbm_archive(archive, [(r["class"], r["index"]) for r in results])
     arms: dict = {}
     verdicts = []
     for result in results:

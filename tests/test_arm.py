@@ -283,6 +283,20 @@ def test_the_chain_bounds_a_prismatic_joint(tmp_path):
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm" / "panda" / "problems.tar.bz2"
 
 
+def test_an_archive_read_for_some_problems_reads_just_those_as_read_one_by_one():
+    from kcplan.arm.mbm import load_mbm_archive, read_mbm_archive
+
+    problems = load_mbm_archive(MBM, [("box", 2), ("cage", 100), ("cage", 101), ("shelf", 1)])
+    assert sorted(problems) == [("box", 2), ("cage", 100)]  # what the archive lacks is skipped
+    for (problem_class, index), problem in problems.items():
+        alone = read_mbm_archive(MBM, problem_class, index)
+        assert problem.joints == alone.joints and problem.allowed == alone.allowed
+        assert np.array_equal(problem.goal, alone.goal)
+        assert [ob.center.tolist() for ob in problem.obstacles] == [
+            ob.center.tolist() for ob in alone.obstacles
+        ]
+
+
 def test_an_mbm_problem_is_read_with_its_obstacles_goal_and_allowed_pairs():
     from kcplan.arm.mbm import read_mbm_archive
 

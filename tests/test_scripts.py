@@ -364,9 +364,9 @@ CASES.append(
 )
 
 CASES.append(
-    Case(  # the 4-body cover: the bundled scenarios' (arm_edge_cost.py's case fits it first)
+    Case(  # the default representation (the links' hulls), as the bundled scenarios'
         "mbm_bench.py",
-        ("--per-class", "1", "--classes", "table_pick", "--bodies-per-link", "4")
+        ("--per-class", "1", "--classes", "table_pick")
         + ("--planners", "kc-rrtconnect,rrtconnect", "--time", "2", "-o", "{tmp}"),
         (
             r"^\| class \| problems \| invalid for the cover \| kc-rrtconnect solved \| ",

@@ -20,7 +20,7 @@ from __future__ import annotations
 import io
 import os
 import tarfile
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -218,8 +218,13 @@ def read_mbm_archive(archive: str | os.PathLike, problem: str, index: int) -> Mb
     return _problem(scene, request, scene_name, request_name)
 
 
-def load_mbm_archive(archive: str | os.PathLike) -> dict[tuple[str, int], MbmProblem]:
-    """Every problem of VAMP's ``problems.tar.bz2``, keyed by ``(class, index)``."""
+def load_mbm_archive(
+    archive: str | os.PathLike, keys: Collection[tuple[str, int]] | None = None
+) -> dict[tuple[str, int], MbmProblem]:
+    """The problems of VAMP's ``problems.tar.bz2``, keyed by ``(class, index)``: every
+    one, or those of ``keys`` that the archive has (only they are parsed: the YAML of all
+    700 takes seconds)."""
+    wanted = None if keys is None else set(keys)
     texts: dict[tuple[str, int, str], tuple[bytes, str]] = {}
     try:
         with tarfile.open(archive) as tar:
@@ -232,6 +237,8 @@ def load_mbm_archive(archive: str | os.PathLike) -> dict[tuple[str, int], MbmPro
                 kind = "scene" if file.startswith("scene") else "request"
                 digits = file[len(kind) : -len(".yaml")]
                 if problem is None or not digits.isdigit():
+                    continue
+                if wanted is not None and (problem, int(digits)) not in wanted:
                     continue
                 texts[problem, int(digits), kind] = (tar.extractfile(member).read(), member.name)
     except (OSError, tarfile.TarError) as err:
