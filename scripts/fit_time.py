@@ -1,11 +1,12 @@
-"""What a cover fit costs with Khachiyan's rank-one updates, and without them (the ablation).
+"""What a cover fit costs with Khachiyan's iteration in three forms (the ablations).
 
-Fits each mesh with K ellipsoids twice in one process, alternating: with
-``kcplan.geometry.enclosing.REFRESH = 0`` (a new inverse of ``V(u)`` and every ``g`` at
-each step of Khachiyan's iteration, the textbook form) and with the default (Sherman and
-Morrison's rank-one updates, afresh every ``REFRESH`` steps). Both take the same steps,
-so the covers agree; the table gives the seconds of each, their ratio and the union's
-volume over the part's of both (Monte Carlo, 200,000 samples)::
+Fits each mesh with K ellipsoids three times in one process, in turn: the textbook
+iteration in Python (``kcplan.geometry.enclosing.REFRESH = 0``: a new inverse of ``V(u)``
+and every ``g`` at each step), Sherman and Morrison's rank-one updates in Python
+(``BACKEND = "python"``, afresh every ``REFRESH`` steps) and the same in the compiled
+kernel (the default, ``kcplan/_kernel/enclosing.hpp``). All three take the same steps, so
+the covers agree; the table gives the seconds of each, the ratios of each to the one
+before, and the union's volume over the part's of each (Monte Carlo, 200,000 samples)::
 
     python scripts/fit_time.py [--meshes A.stl B.stl ...] [--profiles u_channel,...]
         [--bodies 4,8]
@@ -29,18 +30,23 @@ from kcplan.geometry import enclosing
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cover_tightness import add_part_options, chosen_parts, label  # noqa: E402
 
+VARIANTS = {"textbook": ("python", 0), "rank-one": ("python", None), "kernel": ("kernel", None)}
+"""Each form of the iteration: its backend and ``REFRESH`` (None: the module's)."""
 
-def fit(path: Path, bodies: int, refresh: int) -> tuple[float, float]:
-    """Seconds of one fit with ``REFRESH = refresh``, and its union / part volume."""
+
+def fit(path: Path, bodies: int, backend: str, refresh: int | None) -> tuple[float, float]:
+    """Seconds of one fit with the iteration on ``backend`` and ``REFRESH = refresh``, and
+    its union / part volume."""
     solid = read_solid(path)
-    saved = enclosing.REFRESH
-    enclosing.REFRESH = refresh
+    saved = enclosing.BACKEND, enclosing.REFRESH
+    enclosing.BACKEND = backend
+    enclosing.REFRESH = saved[1] if refresh is None else refresh
     try:
         start = time.perf_counter()
         cover = fit_cover(solid, bodies=bodies)
         seconds = time.perf_counter() - start
     finally:
-        enclosing.REFRESH = saved
+        enclosing.BACKEND, enclosing.REFRESH = saved
     return seconds, union_volume(cover.bodies, 200_000)[0] / solid.volume
 
 
@@ -49,23 +55,28 @@ def main() -> None:
     add_part_options(parser, "4,8", "4,8")
     args = parser.parse_args()
     lines = [
-        "| mesh | K | textbook: s | rank-one: s | ratio | union / part, textbook | rank-one |",
-        "|---|---|---|---|---|---|---|",
+        "| mesh | K | textbook: s | rank-one: s | kernel: s | rank-one / textbook "
+        "| kernel / rank-one | union / part, textbook | rank-one | kernel |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    total = [0.0, 0.0]
+    total = dict.fromkeys(VARIANTS, 0.0)
     with tempfile.TemporaryDirectory() as tmp:
         paths, bodies = chosen_parts(args, Path(tmp))
         for path in paths:
             for k in bodies:
-                (t0, v0), (t1, v1) = fit(path, k, 0), fit(path, k, enclosing.REFRESH)
-                total[0] += t0
-                total[1] += t1
+                runs = {name: fit(path, k, *how) for name, how in VARIANTS.items()}
+                for name, (seconds, _) in runs.items():
+                    total[name] += seconds
+                (t0, v0), (t1, v1), (t2, v2) = runs.values()
                 lines.append(
-                    f"| {label(path)} | {k} | {t0:.1f} | {t1:.1f} | {t1 / t0:.2f} "
-                    f"| {v0:.3f} | {v1:.3f} |"
+                    f"| {label(path)} | {k} | {t0:.1f} | {t1:.1f} | {t2:.1f} | {t1 / t0:.2f} "
+                    f"| {t2 / t1:.2f} | {v0:.3f} | {v1:.3f} | {v2:.3f} |"
                 )
                 print(lines[-1], file=sys.stderr, flush=True)
-    lines.append(f"| all | | {total[0]:.1f} | {total[1]:.1f} | {total[1] / total[0]:.2f} | | |")
+    t0, t1, t2 = total.values()
+    lines.append(
+        f"| all | | {t0:.1f} | {t1:.1f} | {t2:.1f} | {t1 / t0:.2f} | {t2 / t1:.2f} | | | |"
+    )
     print("\n".join(lines))
 
 

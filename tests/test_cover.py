@@ -39,6 +39,7 @@ from kcplan.geometry.enclosing import (
     ellipsoid_axes,
     ellipsoid_volume,
     enclose,
+    khachiyan_weights,
     mahalanobis_sq,
     minimum_volume_ellipsoid,
 )
@@ -179,16 +180,49 @@ def test_mvee_stops_on_its_tolerance_despite_rank_one_updates(n, m, tol, seed):
     within the iteration limit even at ``tol = 1e-7`` on clouds a thousand times thinner
     one way (a point dropped from the support and chosen again must be able to leave it
     again, or the iteration crawls). And it takes the textbook iteration's steps: with
-    ``REFRESH = 0`` (a new inverse every step) the same ellipsoid comes out."""
+    ``REFRESH = 0`` (a new inverse every step) the same ellipsoid comes out. The compiled
+    iteration (the default) and its Python twin are held to all of this alike."""
     rng = np.random.default_rng(seed)
     P = rng.normal(size=(m, n)) * 10 ** rng.uniform(-3, 0, n) + rng.normal(size=n)
-    c, M = minimum_volume_ellipsoid(P, tol=tol)
-    assert mahalanobis_sq(P, c, M).max() <= 1.0 + tol * (n + 1) / n + 1e-9
+    c0, M0 = minimum_volume_ellipsoid(P, tol=tol, backend="python")
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(enclosing, "REFRESH", 0)
-        c0, M0 = minimum_volume_ellipsoid(P, tol=tol)
-    np.testing.assert_allclose(c, c0, rtol=1e-8, atol=1e-9)
-    np.testing.assert_allclose(M, M0, rtol=1e-8, atol=1e-9 * np.abs(M0).max())
+        textbook = [minimum_volume_ellipsoid(P, tol=tol, backend=b) for b in ("python", "kernel")]
+    for c, M in [minimum_volume_ellipsoid(P, tol=tol), *textbook]:
+        assert mahalanobis_sq(P, c, M).max() <= 1.0 + tol * (n + 1) / n + 1e-9
+        np.testing.assert_allclose(c, c0, rtol=1e-8, atol=1e-9)
+        np.testing.assert_allclose(M, M0, rtol=1e-8, atol=1e-9 * np.abs(M0).max())
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(2, 3), st.integers(4, 200), st.integers(0, 2**31))
+def test_the_kernels_khachiyan_weights_are_the_python_twins(n, m, seed):
+    """The compiled iteration takes the Python loop's steps: the same weights to rounding,
+    on clouds with exact ties too (points on a lattice)."""
+    from kcplan._kernel import _core
+
+    rng = np.random.default_rng(seed)
+    P = rng.normal(size=(m, n)) * 10 ** rng.uniform(-2, 0, n)
+    if seed % 3 == 0:
+        P = np.round(P * 2) / 2  # a lattice: ties everywhere
+    if np.linalg.matrix_rank(P - P.mean(axis=0)) < n:
+        return  # the iteration needs a full-dimensional set (the caller flattens the rest)
+    X = np.ascontiguousarray(P - P.mean(axis=0))
+    u = np.asarray(_core.khachiyan_weights(X, 1e-4, 20_000, enclosing.REFRESH, enclosing.TIE))
+    twin = khachiyan_weights(X, 1e-4, 20_000)
+    assert u.shape == twin.shape and abs(u.sum() - 1.0) < 1e-12 and u.min() >= 0.0
+    np.testing.assert_allclose(u, twin, rtol=1e-7, atol=1e-10)
+
+
+def test_the_kernels_khachiyan_iteration_refuses_what_it_cannot_fit():
+    from kcplan._kernel import _core
+
+    with pytest.raises(ValueError, match="points: expected 2 or 3 columns"):
+        _core.khachiyan_weights(np.zeros((5, 4)), 1e-3, 100, 64, 1e-9)
+    with pytest.raises(ValueError, match="points: expected more points than dimensions"):
+        _core.khachiyan_weights(np.zeros((3, 3)), 1e-3, 100, 64, 1e-9)
+    with pytest.raises(ValueError, match="backend: expected 'kernel' or 'python', got 'gpu'"):
+        minimum_volume_ellipsoid(np.eye(3), backend="gpu")
 
 
 @pytest.mark.parametrize("seed", [28, 140, 161])
@@ -199,20 +233,23 @@ def test_mvee_converges_on_a_thin_cloud_at_a_tight_tolerance(seed):
     iteration limit 1e-5 to 1e-4 above ``1 + tol (n + 1) / n``."""
     rng = np.random.default_rng(seed)
     P = rng.normal(size=(300, 3)) * 10 ** rng.uniform(-3, 0, 3)
-    c, M = minimum_volume_ellipsoid(P, tol=1e-7)
-    assert mahalanobis_sq(P, c, M).max() <= 1.0 + 1e-7 * 4 / 3 + 1e-9
+    for backend in ("kernel", "python"):
+        c, M = minimum_volume_ellipsoid(P, tol=1e-7, backend=backend)
+        assert mahalanobis_sq(P, c, M).max() <= 1.0 + 1e-7 * 4 / 3 + 1e-9
 
 
 def test_a_pipes_cover_takes_the_textbook_steps(tmp_path):
     """A pipe's rings of vertices tie everywhere: the first of near ties (``TIE``) makes
     the rank-one updates choose what a new inverse per step chooses, where their rounding
     differs (without it a pipe's cover at K = 4 ended 0.2 % apart, and at K = 8 the fit
-    went another way and took 3x longer; at K = 2, here, the bodies differ)."""
+    went another way and took 3x longer; at K = 2, here, the bodies differ). The compiled
+    iteration's cover (the default) against the textbook one in Python."""
     PROFILES["pipe"]().export(tmp_path / "pipe.stl")
     solid = read_solid(tmp_path / "pipe.stl")
     cover = fit_cover(solid, bodies=2)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(enclosing, "REFRESH", 0)
+        patch.setattr(enclosing, "BACKEND", "python")
         textbook = fit_cover(solid, bodies=2)
     assert len(cover.bodies) == len(textbook.bodies) == 2
     for body, other in zip(cover.bodies, textbook.bodies, strict=True):

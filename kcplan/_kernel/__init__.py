@@ -24,6 +24,7 @@ C++ (``kcplan/_kernel/``)               Python twin
 ``arm_world.hpp`` ``ArmWorld``          :class:`kcplan.arm.ArmWorld`
 ``pair_motion.hpp`` ``PairFirstOrder``  :func:`kcplan.arm.bounds.relative_first_order`
 ``arm_certifier.hpp`` ``ArmCertifier``  :mod:`kcplan.planning.arm_certifier`
+``enclosing.hpp``                       :func:`kcplan.geometry.enclosing.khachiyan_weights`
 ======================================= ======================================================
 
 Conventions: poses are flat, ``[x, y, yaw]`` or ``[x, y, z, qx, qy, qz, qw]`` (scalar

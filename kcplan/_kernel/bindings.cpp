@@ -1,6 +1,7 @@
 // Python bindings of the kernel: thin wrappers, no logic. Every C++ exception becomes a
 // Python exception (std::invalid_argument -> ValueError) through nanobind.
 #include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
 #include <nanobind/stl/array.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/unique_ptr.h>
@@ -8,6 +9,7 @@
 
 #include "arm_certifier.hpp"
 #include "certifier.hpp"
+#include "enclosing.hpp"
 #include "pair_proof.hpp"
 
 namespace nb = nanobind;
@@ -409,6 +411,18 @@ NB_MODULE(_core, m) {
         std::fill(w.scene().body_query_counts.begin(), w.scene().body_query_counts.end(), 0);
         w.pair_queries = 0, w.part_queries = 0;
       });
+
+  m.def(
+      "khachiyan_weights",
+      [](nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu> points,
+         double tol, std::int64_t max_iterations, std::int64_t refresh, double tie) {
+        return kcplan::khachiyan_weights(points.data(), static_cast<std::int64_t>(points.shape(0)),
+                                         static_cast<int>(points.shape(1)), tol, max_iterations,
+                                         refresh, tie);
+      },
+      "points"_a, "tol"_a, "max_iterations"_a, "refresh"_a, "tie"_a,
+      "Khachiyan's weights of the minimum-volume ellipsoid around the rows of points "
+      "(centred hull vertices): kcplan/_kernel/enclosing.hpp");
 
   m.def(
       "prove_pairs_apart",

@@ -11,6 +11,8 @@ Khachiyan's algorithm for the computation of minimum-volume enclosing ellipsoids
 Discrete Appl. Math. 155, 2007, with their away steps and Kumar and Yildirim's start;
 each step changes ``V(u) = Q diag(u) Q^T`` by rank one, so its inverse and every
 ``g_i = q_i^T V(u)^-1 q_i`` follow by Sherman and Morrison's formula in O(m n)).
+The compiled kernel runs the same iteration (``kcplan/_kernel/enclosing.hpp``, the default
+:data:`BACKEND`); :func:`khachiyan_weights` is its Python twin.
 It is an *approximation*: the ellipsoid it returns need
 not contain every point. :func:`enclose` makes containment exact by scaling about the
 centre, which is what a sound cover needs; the approximation then only costs volume, at
@@ -28,6 +30,7 @@ __all__ = [
     "ellipsoid_volume",
     "enclose",
     "frame_norm_sq",
+    "khachiyan_weights",
     "mahalanobis_sq",
     "minimum_volume_ellipsoid",
 ]
@@ -40,6 +43,11 @@ fresh values)."""
 TIE = 1e-9
 """Values of ``g`` within this share of the largest (smallest) tie for Khachiyan's step
 towards (away from) a point: the first of them is taken."""
+
+BACKEND = "kernel"
+"""Who runs Khachiyan's iteration when :func:`minimum_volume_ellipsoid` is not told:
+``"kernel"`` (compiled) or ``"python"`` (:func:`khachiyan_weights`; the ablation of
+``scripts/fit_time.py``). Both take the same steps."""
 
 FLAT_RATIO = 1e-6
 """Point sets whose thinnest principal spread is below this fraction of the widest are
@@ -99,7 +107,7 @@ def _flat_ellipsoid(P: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def minimum_volume_ellipsoid(
-    points: ArrayLike, tol: float = 1e-3, max_iterations: int = 20_000
+    points: ArrayLike, tol: float = 1e-3, max_iterations: int = 20_000, backend: str | None = None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Approximate minimum-volume ellipsoid around points (Khachiyan's algorithm).
 
@@ -112,6 +120,11 @@ def minimum_volume_ellipsoid(
         iteration's scale (Todd and Yildirim's ``epsilon``).
     max_iterations : int
         Safety limit; the result is still an ellipsoid near the points.
+    backend : {"kernel", "python"}, optional
+        Who runs the iteration: the compiled kernel (``kcplan/_kernel/enclosing.hpp``,
+        the same steps without numpy's per-call cost on a few hundred points) or this
+        module's loop (:func:`khachiyan_weights`, its twin and reference); default
+        :data:`BACKEND`.
 
     Returns
     -------
@@ -119,6 +132,9 @@ def minimum_volume_ellipsoid(
     M : ndarray, shape (n, n)
         Not guaranteed to contain every point: pass the result through :func:`enclose`.
     """
+    backend = BACKEND if backend is None else backend
+    if backend not in ("kernel", "python"):
+        raise ValueError(f"backend: expected 'kernel' or 'python', got {backend!r}")
     P = np.asarray(points, dtype=float)
     if P.ndim != 2 or len(P) == 0 or P.shape[1] not in (2, 3):
         raise ValueError(f"points: expected an (m, 2) or (m, 3) array, got shape {P.shape}")
@@ -132,6 +148,35 @@ def minimum_volume_ellipsoid(
         return _flat_ellipsoid(P)
     origin = P.mean(axis=0)
     X = P - origin
+    if backend == "kernel":
+        from kcplan._kernel import _core  # compiled twin: the bottom of the layers too
+
+        u = np.asarray(
+            _core.khachiyan_weights(np.ascontiguousarray(X), tol, max_iterations, REFRESH, TIE)
+        )
+    else:
+        u = khachiyan_weights(X, tol, max_iterations)
+    c = X.T @ u
+    S = (X.T * u) @ X - np.outer(c, c)
+    try:
+        return c + origin, np.linalg.inv(S) / n
+    except np.linalg.LinAlgError:  # pragma: no cover - the support collapsed
+        return _flat_ellipsoid(P)
+
+
+def khachiyan_weights(X: ArrayLike, tol: float, max_iterations: int) -> NDArray[np.float64]:
+    """Khachiyan's weights ``u`` ``(m,)`` (summing to 1) of the minimum-volume ellipsoid
+    around the rows of ``X`` ``(m, n)``: full-dimensional points, best the hull's vertices
+    centred; the ellipsoid is ``c = X^T u``, ``M = (X^T diag(u) X - c c^T)^-1 / n``.
+
+    Todd and Yildirim's form with away steps and Kumar and Yildirim's start (module
+    docstring), rank-one updates refreshed every :data:`REFRESH` steps, ties broken by
+    :data:`TIE`; stops when every ``g_l / (n + 1) - 1 <= tol`` on fresh values or after
+    ``max_iterations`` steps. The twin of the kernel's ``khachiyan_weights``
+    (``kcplan/_kernel/enclosing.hpp``), which takes the same steps.
+    """
+    X = np.asarray(X, dtype=float)
+    n = X.shape[1]
     Q = np.vstack([X.T, np.ones(len(X))])  # lifted points, (n + 1, m)
     # Kumar and Yildirim's start: the extreme points along each axis
     u = np.zeros(len(X))
@@ -190,12 +235,7 @@ def minimum_volume_ellipsoid(
         g -= h
         g *= keep
         fresh += 1
-    c = X.T @ u
-    S = (X.T * u) @ X - np.outer(c, c)
-    try:
-        return c + origin, np.linalg.inv(S) / n
-    except np.linalg.LinAlgError:  # pragma: no cover - the support collapsed
-        return _flat_ellipsoid(P)
+    return u
 
 
 def enclose(
