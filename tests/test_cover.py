@@ -221,6 +221,10 @@ def test_the_kernels_khachiyan_iteration_refuses_what_it_cannot_fit():
         _core.khachiyan_weights(np.zeros((5, 4)), 1e-3, 100, 64, 1e-9)
     with pytest.raises(ValueError, match="points: expected more points than dimensions"):
         _core.khachiyan_weights(np.zeros((3, 3)), 1e-3, 100, 64, 1e-9)
+    cloud = np.random.default_rng(1).normal(size=(10, 3))
+    cloud[4, 1] = np.nan
+    with pytest.raises(ValueError, match="points: expected finite coordinates"):
+        _core.khachiyan_weights(cloud, 1e-3, 100, 64, 1e-9)
     with pytest.raises(ValueError, match="backend: expected 'kernel' or 'python', got 'gpu'"):
         minimum_volume_ellipsoid(np.eye(3), backend="gpu")
 

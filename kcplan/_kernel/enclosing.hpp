@@ -25,12 +25,15 @@ namespace kcplan {
 /// may differ, which `tie` keeps from choosing a step. Stops when every g_l / (n + 1) - 1
 /// <= `tol` on fresh values, or after `max_iterations` steps. The ellipsoid is
 /// c = sum u_l x_l, M = (sum u_l x_l x_l^T - c c^T)^-1 / n (the caller's part). Throws
-/// std::invalid_argument for a dimension other than 2 or 3 or fewer than n + 1 points.
+/// std::invalid_argument for a dimension other than 2 or 3, fewer than n + 1 points or a
+/// coordinate that is not finite.
 inline std::vector<double> khachiyan_weights(const double* x, std::int64_t m, int n,
                                              double tol, std::int64_t max_iterations,
                                              std::int64_t refresh, double tie) {
   if (n != 2 && n != 3) throw std::invalid_argument("points: expected 2 or 3 columns");
   if (m <= n) throw std::invalid_argument("points: expected more points than dimensions");
+  for (std::int64_t l = 0; l < m * n; ++l)
+    if (!std::isfinite(x[l])) throw std::invalid_argument("points: expected finite coordinates");
   using Matrix = Eigen::MatrixXd;
   using Vector = Eigen::VectorXd;
   const int d = n + 1;
@@ -61,14 +64,19 @@ inline std::vector<double> khachiyan_weights(const double* x, std::int64_t m, in
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> barred(m, 0.0);  // +inf where u_l = 0: no away step from those
   std::int64_t fresh = 0;              // rank-one updates since g was computed afresh
+  // the first index where `holds` (numpy's argmax of a mask: 0 where none does)
+  auto first = [m](auto&& holds) {
+    for (std::int64_t l = 0; l < m; ++l)
+      if (holds(l)) return l;
+    return std::int64_t{0};
+  };
   for (std::int64_t it = 0; it < max_iterations; ++it) {
     const double top = g.maxCoeff();
-    std::int64_t j = 0;
-    while (!(g[j] >= top - tie * std::abs(top))) ++j;
+    const std::int64_t j = first([&](std::int64_t l) { return g[l] >= top - tie * std::abs(top); });
     double low = inf;
     for (std::int64_t l = 0; l < m; ++l) low = std::min(low, g[l] + barred[l]);
-    std::int64_t k = 0;
-    while (!(g[k] + barred[k] <= low + tie * std::abs(low))) ++k;
+    const std::int64_t k =
+        first([&](std::int64_t l) { return g[l] + barred[l] <= low + tie * std::abs(low); });
     const double grow = g[j] / dd - 1.0, shrink = 1.0 - g[k] / dd;
     std::int64_t i = -1;
     double step = 0.0;

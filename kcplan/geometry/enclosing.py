@@ -149,7 +149,7 @@ def minimum_volume_ellipsoid(
     origin = P.mean(axis=0)
     X = P - origin
     if backend == "kernel":
-        from kcplan._kernel import _core  # compiled twin: the bottom of the layers too
+        from kcplan._kernel import _core  # below every Python layer: no import circle
 
         u = np.asarray(
             _core.khachiyan_weights(np.ascontiguousarray(X), tol, max_iterations, REFRESH, TIE)
@@ -166,8 +166,9 @@ def minimum_volume_ellipsoid(
 
 def khachiyan_weights(X: ArrayLike, tol: float, max_iterations: int) -> NDArray[np.float64]:
     """Khachiyan's weights ``u`` ``(m,)`` (summing to 1) of the minimum-volume ellipsoid
-    around the rows of ``X`` ``(m, n)``: full-dimensional points, best the hull's vertices
-    centred; the ellipsoid is ``c = X^T u``, ``M = (X^T diag(u) X - c c^T)^-1 / n``.
+    around the rows of ``X`` ``(m, n)``, full-dimensional points (best: the hull's
+    vertices, centred); the ellipsoid is ``c = X^T u``, ``M = (X^T diag(u) X - c c^T)^-1
+    / n``.
 
     Todd and Yildirim's form with away steps and Kumar and Yildirim's start (module
     docstring), rank-one updates refreshed every :data:`REFRESH` steps, ties broken by
