@@ -153,6 +153,7 @@ def plot(rows: list[dict], path: Path) -> None:
         ax.plot(k, [r["ellipsoid_ratio"] - 1 for r in sub], "-o", color=colour, label=mesh)
         ax.plot(k, [r["sphere_ratio"] - 1 for r in sub], "--s", color=colour, alpha=0.6)
     ax.set_yscale("log")
+    ax.set_xticks(sorted({r["bodies"] for r in rows}))  # K is a count: no 4.5 between
     ax.set_xlabel("bodies K")
     ax.set_ylabel("excess volume (union / part - 1)")
     ax.set_title("covers by K ellipsoids (solid) and K spheres (dashed)", fontsize=10)
