@@ -12,6 +12,7 @@ import os
 import re
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -211,6 +212,55 @@ def test_the_kernels_khachiyan_weights_are_the_python_twins(n, m, seed):
     twin = khachiyan_weights(X, 1e-4, 20_000)
     assert u.shape == twin.shape and abs(u.sum() - 1.0) < 1e-12 and u.min() >= 0.0
     np.testing.assert_allclose(u, twin, rtol=1e-7, atol=1e-10)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31), st.integers(1, 3000), st.sampled_from([2, 3]))
+def test_repeated_rows_are_dropped_and_nothing_else(seed, m, n):
+    """The fit's de-duplication before qhull (`_without_repeats`): exactly the distinct
+    rows, each at its first occurrence and in that order (signed zeros are distinct
+    bits and may stay apart, which only costs time)."""
+    from kcplan.cover.fit import _without_repeats
+
+    rng = np.random.default_rng(seed)
+    pool = rng.normal(size=(max(1, m // 5), n))
+    P = pool[rng.integers(0, len(pool), m)]
+    out = _without_repeats(P)
+    first = {}
+    for i, row in enumerate(P):
+        first.setdefault(row.tobytes(), i)
+    np.testing.assert_array_equal(out, P[sorted(first.values())])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([2, 3]))
+def test_the_scorers_slab_counts_the_same_points_as_every_point_measured(seed, n):
+    """`_Scorer.inside` measures only the sample points in the ellipsoid's slab along x;
+    it finds the very points the full measurement finds, for ellipsoids inside, across
+    and outside the sampled box."""
+    from kcplan.cover.fit import _Scorer
+
+    rng = np.random.default_rng(seed)
+    corners = rng.uniform(-1.0, 1.0, size=(4, 2, n))  # only the sampled box matters
+    scorer = _Scorer(SimpleNamespace(boundary=corners, dimension=n))
+    R = np.linalg.qr(rng.normal(size=(n, n)))[0]
+    a = 10 ** rng.uniform(-2, 0.5, n)
+    M = R @ np.diag(1 / a**2) @ R.T
+    c = rng.uniform(-1.5, 1.5, n)
+    expected = mahalanobis_sq(scorer.points, c, M) <= 1.0
+    np.testing.assert_array_equal(scorer.inside(c, M), expected)
+
+
+def test_an_mvee_told_its_points_are_hull_vertices_is_the_same():
+    """`hull_vertices=True` skips qhull; given the hull's vertices it is the same fit."""
+    from scipy.spatial import ConvexHull
+
+    P = np.random.default_rng(3).normal(size=(400, 3)) * (1.0, 0.3, 0.1)
+    V = P[ConvexHull(P).vertices]
+    c0, M0 = minimum_volume_ellipsoid(P, tol=1e-6)
+    c1, M1 = minimum_volume_ellipsoid(V, tol=1e-6, hull_vertices=True)
+    np.testing.assert_allclose(c1, c0, atol=1e-12)
+    np.testing.assert_allclose(M1, M0, rtol=1e-9)
 
 
 def test_the_kernels_khachiyan_iteration_refuses_what_it_cannot_fit():

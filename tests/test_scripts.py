@@ -62,6 +62,17 @@ def _same_covers(out: str, _tmp: Path) -> None:
     assert rows and all(len(set(volumes)) == 1 for _, *volumes in rows), rows
 
 
+def _never_looser(out: str, _tmp: Path) -> None:
+    """The vertices' trees only add trees to choose from: never a looser cover than the
+    curvature's alone, beyond the Monte Carlo's 95 % intervals."""
+    rows = re.findall(
+        r"^\| \S+ \| \d+ \| ([\d.]+) \+- ([\d.]+) \| ([\d.]+) \+- ([\d.]+) \|", out, re.M
+    )
+    assert rows, out
+    for alone, e0, both, e1 in (map(float, row) for row in rows):
+        assert both <= alone + e0 + e1, (alone, both)
+
+
 def _no_violation(out: str, _tmp: Path, names=tuple(CERTIFICATE_SETS)) -> None:
     rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 100 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
     assert {(n, name) for n, name, *_ in rows} == {
@@ -142,6 +153,16 @@ CASES = [
             rf"^\| all \| \| {NUMBER} \| {NUMBER} \| {NUMBER} \| {NUMBER} \| {NUMBER} \| \| \| \|$",
         ),
         check=_same_covers,
+    ),
+    Case(
+        "vertex_cuts.py",
+        ("--meshes", "scenarios/3d/meshes/l_bracket.stl", "--profiles", "", "--bodies", "2"),
+        (
+            rf"^\| meshes/l_bracket\.stl \| 2 \| {NUMBER} \+- {NUMBER} \| {NUMBER} \+- {NUMBER} "
+            rf"\| {NUMBER} \| {NUMBER} \| {NUMBER} \|$",
+            rf"^\| all \| \| \| \| {NUMBER} \| {NUMBER} \| {NUMBER} \|$",
+        ),
+        check=_never_looser,
     ),
     Case(
         "mbm_validity.py",
@@ -382,8 +403,7 @@ CASES.append(
 CASES.append(
     Case(  # one problem, one random corner: the table and a blend re-checked on the meshes
         "trajectory_bench.py",
-        ("--per-class", "1", "--classes", "box", "--corners", "1", "--time", "5")
-        + ("-o", "{tmp}"),
+        ("--per-class", "1", "--classes", "box", "--corners", "1", "--time", "5") + ("-o", "{tmp}"),
         (
             r"^\| class \| solved / valid \| plan, median s \| smooth \+ time, median s \| ",
             rf"^\| box \| 1 / 1 \| {NUMBER} \| {NUMBER} \| 0\.\d\d \| (0\.\d+|1\.000000), "

@@ -29,8 +29,15 @@ is kept: the extra planes help some parts and mislead the greedy choice on other
 third tree starts from the part cut into an even number of *equal sectors* about one of
 those axes (4, 6, ... up to ``bodies``; the best, if its union is smaller than the
 others reached with as many leaves) and is grown from there; a ring or a pipe, whose
-first greedy cut makes two flat rings, is cut into sectors this way. Every tree is a
-tree of planes whose leaves are fitted to their full hull points, so each is sound.
+first greedy cut makes two flat rings, is cut into sectors this way. *Two more trees*
+(:data:`VERTEX_CUTS`) are grown as the first two but with their cuts at quantiles of the
+mesh's clipped triangle corners (the fit before :data:`FIT_VERSION` 3; without the
+sequences of two cuts, which cost a ring's fit twice its time there), and the smallest
+union of all is kept: those cuts follow the triangulation, but as extra trees they can
+only make the cover smaller, never larger, than the curvature's trees make it alone; a
+greedy tree's outcome is partly luck, and on some CAD meshes theirs is the better one.
+Every tree is a tree of planes whose leaves are fitted to their full hull points, so each
+is sound.
 
 *By how far the cover sticks out* (``max_offset``, 3D). Volume does not see a body that
 bulges a centimetre out of a flat face, and a grasp that leaves a finger 9 mm from an
@@ -65,7 +72,7 @@ from scipy.stats import qmc
 
 from kcplan.cover.bodies import body_from_ellipsoid, body_holds, body_matrix
 from kcplan.cover.features import clip_segments, feature_segments, quantiles_along, simplex_normals
-from kcplan.cover.partition import Piece
+from kcplan.cover.partition import Piece, clip_simplices
 from kcplan.cover.solid import Solid
 from kcplan.geometry.enclosing import (
     FLAT_RATIO,
@@ -87,15 +94,17 @@ __all__ = [
     "fit_cover",
 ]
 
-FIT_VERSION = 3
+FIT_VERSION = 4
 """Changes whenever the fit by volume (``bodies`` or ``max_excess``) would give other
 bodies for the same input (cache key). 3: cuts at quantiles of the curvature measure,
-not of the mesh's vertices."""
+not of the mesh's vertices. 4: the vertices' trees as well (:data:`VERTEX_CUTS`)."""
 OFFSET_FIT_VERSION = 2
 """The same for a ``max_offset`` fit, whose candidate cuts are its own
 (:data:`OFFSET_FRACTIONS`)."""
 SHAPES = ("ellipsoid", "sphere")
 CUT_QUANTILES = (0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875)
+UNIQUE_ABOVE = 2000
+"""Points made unique before their hull is taken when there are more than this many."""
 SEARCH_TOL = 1e-2
 """Khachiyan tolerance while scoring candidate cuts (volume within about 1.5 %)."""
 FINAL_TOL = 1e-4
@@ -113,6 +122,15 @@ PENCIL_ANGLES = 6
 """Planes through each axis of the part's ellipsoid, every 180 / this degrees."""
 SECTORS = True
 """Also try the part cut into equal sectors about an axis of its ellipsoid."""
+VERTEX_CUTS = True
+"""Also grow the plain and the pencil trees with cuts at quantiles of the mesh's clipped
+triangle corners (the fit before :data:`FIT_VERSION` 3, but never a sequence of two
+cuts) and keep the smallest union of all (issue 41). Those cuts follow the triangulation
+(a flat face split in many triangles pulls them to it), but as extra trees they can only
+make a cover smaller than the curvature's trees make it alone (on the score's sample);
+the sector tree is chosen by the curvature's trees alone, as without them. On the UR5's
+upper arm they give 1.456 times the part at four bodies against the curvature's 1.511
+(``benchmarks/RESULTS.md`` 24.1), at about twice the fit's time."""
 LOOKAHEAD = 3
 """When no single cut shrinks the union, this many best cuts of each leaf are tried as
 the first of two."""
@@ -199,15 +217,53 @@ class _Leaf:
     features: tuple | None = None  # the curvature measure in the cell, once clipped
 
 
-def _enclosing(points: NDArray, shape: str, tol: float) -> tuple[NDArray, NDArray]:
-    """An ellipsoid (or ball) holding every point, as ``(center, M)``."""
+def _hull_vertices(points: NDArray, unique: bool) -> tuple[NDArray, bool]:
+    """The vertices of the points' convex hull and True, or every point and False when
+    qhull finds them flat: the only points the smallest ellipsoid or ball around them can
+    touch, and where the largest ``(x - c)^T M (x - c)`` lies. A piece's points are its
+    clipped triangles' corners, each vertex about six times over; with ``unique``, many
+    are first made unique (qhull's time grows with the points it is given, but the order
+    of the vertices it returns, which Khachiyan's tie rule follows, changes with them)."""
+    if unique and len(points) > UNIQUE_ABOVE:
+        points = _without_repeats(points)
+    try:
+        return points[ConvexHull(points).vertices], True
+    except (QhullError, ValueError):
+        return points, False
+
+
+def _without_repeats(points: NDArray) -> NDArray:
+    """The rows of ``points`` ``(m, n)`` with bit-identical repeats dropped, in their
+    first order. Rows are sorted by a hash of their bits and a row is dropped only when it
+    equals its predecessor there, so a hash collision keeps both rows (nothing distinct is
+    ever dropped; a repeat may stay). Sorting one integer key is a quarter of the time of
+    ``np.unique(..., axis=0)``'s lexicographic sort."""
+    P = np.ascontiguousarray(points, dtype=np.float64)
+    bits = P.view(np.uint64)
+    key = np.zeros(len(P), dtype=np.uint64)
+    for column, odd in zip(bits.T, _HASH_MULTIPLIERS, strict=False):
+        key = (key ^ column) * odd  # wraps modulo 2^64
+    order = np.argsort(key, kind="stable")
+    sorted_rows = P[order]
+    repeat = np.zeros(len(P), dtype=bool)
+    repeat[1:] = (key[order][1:] == key[order][:-1]) & (sorted_rows[1:] == sorted_rows[:-1]).all(1)
+    return P[np.sort(order[~repeat])]
+
+
+_HASH_MULTIPLIERS = tuple(
+    np.uint64(m) for m in (0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9)
+)
+
+
+def _enclosing(
+    points: NDArray, shape: str, tol: float, unique: bool = False
+) -> tuple[NDArray, NDArray]:
+    """An ellipsoid (or ball) holding every point, as ``(center, M)`` (``unique``: see
+    :func:`_hull_vertices`)."""
+    P, hull = _hull_vertices(points, unique)
     if shape == "sphere":
         from trimesh.nsphere import minimum_nsphere
 
-        try:
-            P = points[ConvexHull(points).vertices]
-        except (QhullError, ValueError):
-            P = points
         try:
             c, r = minimum_nsphere(P)
         except (QhullError, ValueError):  # a flat set: the ball about its box's centre
@@ -217,8 +273,8 @@ def _enclosing(points: NDArray, shape: str, tol: float) -> tuple[NDArray, NDArra
         r = max(float(r), FLAT_RATIO * max(float(np.abs(P).max()), 1e-30))
         M = np.eye(len(c)) / r**2
     else:
-        c, M = minimum_volume_ellipsoid(points, tol)
-    return c, enclose(points, c, M)
+        c, M = minimum_volume_ellipsoid(P, tol, hull_vertices=hull)
+    return c, enclose(P, c, M)
 
 
 def _directions(M: NDArray) -> list[NDArray]:
@@ -310,11 +366,19 @@ class _Scorer:
         pad = 0.1 * (high - low)
         low, high = low - pad, high + pad
         u = qmc.Sobol(solid.dimension, seed=0).random(SCORE_SAMPLES)
+        u = u[np.argsort(u[:, 0], kind="stable")]  # by x, so a body's slab is a slice
         self.points = low + u * (high - low)
         self.cell = float(np.prod(high - low)) / SCORE_SAMPLES
 
     def inside(self, center: NDArray, M: NDArray) -> NDArray[np.bool_]:
-        return mahalanobis_sq(self.points, center, M) <= 1.0
+        """The sample points in the ellipsoid ``(x - c)^T M (x - c) <= 1``; only those in
+        its slab along x (half-width ``sqrt((M^-1)_xx)``, padded) are measured."""
+        half = math.sqrt(max(float(np.linalg.inv(M)[0, 0]), 0.0)) * (1.0 + 1e-6)
+        x = self.points[:, 0]
+        lo, hi = np.searchsorted(x, [center[0] - half, center[0] + half], side="left")
+        out = np.zeros(len(x), dtype=bool)
+        out[lo : hi + 1] = mahalanobis_sq(self.points[lo : hi + 1], center, M) <= 1.0
+        return out
 
     def outside(self, M: NDArray, inside: NDArray[np.bool_]) -> float:
         """Volume of an ellipsoid outside the sampled region (exact volume less the
@@ -333,9 +397,24 @@ class _EmptySector(Exception):
 class _Search:
     """What the search needs of a part: its fitted leaves and their candidate cuts."""
 
-    def __init__(self, solid: Solid, shape: str, pencils: bool, features: tuple | None = None):
+    def __init__(
+        self,
+        solid: Solid,
+        shape: str,
+        pencils: bool,
+        features: tuple | None = None,
+        cuts: str = "features",
+        unique: bool = False,
+    ):
         self.solid = solid
         self.shape = shape
+        self.cuts = cuts
+        """Where cuts cross a leaf (:meth:`offsets`): ``features`` (the part's curvature
+        measure) or ``vertices`` (the mesh's triangle corners, :data:`VERTEX_CUTS`)."""
+        self.unique = unique
+        """Points made unique before their hull (:func:`_hull_vertices`): the fit by
+        volume; the fit by offset keeps the order its bundled covers were fitted in
+        (:data:`OFFSET_FIT_VERSION`)."""
         self.scorer = _Scorer(solid)
         self.faces = _face_planes(solid.boundary)[:2] if FACE_PLANES else None
         self.root = self.leaf(Piece.whole(solid.boundary))
@@ -349,7 +428,7 @@ class _Search:
         """A leaf of the piece, its ellipsoid fitted to its full hull points (``points``,
         if they are known already)."""
         points = piece.points(self.solid.boundary) if points is None else points
-        c, M = _enclosing(points, self.shape, FINAL_TOL)
+        c, M = _enclosing(points, self.shape, FINAL_TOL, self.unique)
         inside = self.scorer.inside(c, M)
         return _Leaf({}, piece, points, c, M, inside, self.scorer.outside(M, inside))
 
@@ -419,7 +498,9 @@ class _Search:
         """Where cuts across ``normal`` may cross ``leaf``: the quantiles
         :data:`CUT_QUANTILES` of the part's curvature measure in the leaf's cell
         (:mod:`kcplan.cover.features`), or of its surface's area there when the cell
-        holds no feature."""
+        holds no feature; of the clipped triangles' corners with ``cuts="vertices"``."""
+        if self.cuts == "vertices":
+            return np.quantile(leaf.piece.boundary_points @ normal, CUT_QUANTILES)
         if self.features is None:
             self.features = feature_segments(self.solid)
         if leaf.features is None:
@@ -448,11 +529,11 @@ class _Search:
         for normal, offset in self.planes(leaf):
             covered = np.zeros(len(self.scorer.points), dtype=bool)
             outside = 0.0
-            for sign in (1.0, -1.0):
-                part = leaf.piece.cut(sign * normal, sign * offset).boundary
+            for sign in (1.0, -1.0):  # the children's boundaries (their cells not needed)
+                part = clip_simplices(leaf.piece.boundary, sign * normal, sign * offset)
                 if len(part) == 0:
                     break
-                c, M = _enclosing(part.reshape(-1, n), self.shape, SEARCH_TOL)
+                c, M = _enclosing(part.reshape(-1, n), self.shape, SEARCH_TOL, self.unique)
                 inside = self.scorer.inside(c, M)
                 covered |= inside
                 outside += self.scorer.outside(M, inside)
@@ -557,9 +638,9 @@ def fit_cover(
         raise ValueError(f"max_excess: expected a positive number, got {max_excess}")
     start = time.perf_counter()
     features = feature_segments(solid)  # for every search: a property of the part
-    searches = [_Search(solid, shape, pencils=False, features=features)]
-    if PENCIL_ANGLES:
-        searches.append(_Search(solid, shape, pencils=True, features=features))
+    cuts = ("features", "vertices")[: 1 + bool(VERTEX_CUTS)]
+    kinds = [(c, p) for c in cuts for p in (False, True)[: 1 + bool(PENCIL_ANGLES)]]
+    searches = [_Search(solid, shape, p, features, c, unique=True) for c, p in kinds]
     target = bodies if bodies is not None else MAX_BODIES
 
     def reporter(label: str) -> Callable[[int], None]:
@@ -574,9 +655,13 @@ def fit_cover(
         for k, s in enumerate(searches)
     ]
     if bodies is not None and SECTORS:
-        sectors = _best_sectors(searches[-1], bodies, growths)
+        # the curvature's own trees decide, as they would alone: a tree of the vertices'
+        # cuts may only make the cover smaller (VERTEX_CUTS)
+        own = [k for k, kind in enumerate(kinds) if kind[0] == "features"]
+        search = searches[own[-1]]
+        sectors = _best_sectors(search, bodies, [growths[k] for k in own])
         if sectors is not None:
-            growths.append(_grow(searches[-1], *sectors, bodies, None, reporter("sectors")))
+            growths.append(_grow(search, *sectors, bodies, None, reporter("sectors")))
     if max_excess is None:
         growth = min(growths, key=lambda g: g.union)
     else:  # the fewest bodies within the bound, then the smallest union
@@ -630,7 +715,7 @@ def _grow(
         union, k, normal, offset = search.best_cut(leaves)
         if union < growth.union:
             children = search.children(leaves[k], normal, offset)
-        elif len(leaves) + 2 > target or not LOOKAHEAD:
+        elif len(leaves) + 2 > target or not LOOKAHEAD or search.cuts == "vertices":
             growth.note = _stopped(len(leaves), "no cut made the cover smaller")
             break
         else:

@@ -107,7 +107,11 @@ def _flat_ellipsoid(P: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def minimum_volume_ellipsoid(
-    points: ArrayLike, tol: float = 1e-3, max_iterations: int = 20_000, backend: str | None = None
+    points: ArrayLike,
+    tol: float = 1e-3,
+    max_iterations: int = 20_000,
+    backend: str | None = None,
+    hull_vertices: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Approximate minimum-volume ellipsoid around points (Khachiyan's algorithm).
 
@@ -125,6 +129,9 @@ def minimum_volume_ellipsoid(
         the same steps without numpy's per-call cost on a few hundred points) or this
         module's loop (:func:`khachiyan_weights`, its twin and reference); default
         :data:`BACKEND`.
+    hull_vertices : bool
+        The points are the vertices of their convex hull already (as
+        ``points[ConvexHull(points).vertices]``): qhull is not run again.
 
     Returns
     -------
@@ -142,10 +149,11 @@ def minimum_volume_ellipsoid(
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if len(P) <= n or spread[-1] <= FLAT_RATIO * max(float(spread[0]), 1e-300):
         return _flat_ellipsoid(P)
-    try:  # only hull vertices can touch the MVEE
-        P = P[ConvexHull(P).vertices]
-    except QhullError:
-        return _flat_ellipsoid(P)
+    if not hull_vertices:
+        try:  # only hull vertices can touch the MVEE
+            P = P[ConvexHull(P).vertices]
+        except QhullError:
+            return _flat_ellipsoid(P)
     origin = P.mean(axis=0)
     X = P - origin
     if backend == "kernel":
