@@ -650,9 +650,11 @@ def fit_cover(
 
         return report
 
+    cut_names = {"features": "curvature's cuts", "vertices": "vertices' cuts"}
+    names = {(c, p): cut_names[c] + " and pencils" * p for c, p in kinds}
     growths = [
-        _grow(s, s.root.node, [s.root], target, max_excess, reporter(f"search {k + 1}"))
-        for k, s in enumerate(searches)
+        _grow(s, s.root.node, [s.root], target, max_excess, reporter(names[kind]))
+        for kind, s in zip(kinds, searches, strict=True)
     ]
     if bodies is not None and SECTORS:
         # the curvature's own trees decide, as they would alone: a tree of the vertices'
