@@ -149,7 +149,7 @@ def plot(rows: list[dict], path: Path) -> None:
     for i, mesh in enumerate(meshes):
         sub = [r for r in rows if r["mesh"] == mesh]
         k = [r["bodies"] for r in sub]
-        colour = plt.get_cmap("tab10").colors[i % 10]
+        colour = plt.get_cmap("tab20").colors[(2 * i) % 20 + (i // 10) % 2]  # 20 apart
         ax.plot(k, [r["ellipsoid_ratio"] - 1 for r in sub], "-o", color=colour, label=mesh)
         ax.plot(k, [r["sphere_ratio"] - 1 for r in sub], "--s", color=colour, alpha=0.6)
     ax.set_yscale("log")
@@ -157,7 +157,7 @@ def plot(rows: list[dict], path: Path) -> None:
     ax.set_xlabel("bodies K")
     ax.set_ylabel("excess volume (union / part - 1)")
     ax.set_title("covers by K ellipsoids (solid) and K spheres (dashed)", fontsize=10)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the lines
     ax.grid(alpha=0.3)
     save_figure(fig, path)
 
