@@ -251,6 +251,22 @@ def test_the_scorers_slab_counts_the_same_points_as_every_point_measured(seed, n
     np.testing.assert_array_equal(scorer.inside(c, M), expected)
 
 
+def test_convex_hull_vertices_are_the_corners_or_every_point_of_a_flat_set():
+    """A cube's 8 corners among its centre and edge midpoints, in the input's order; a
+    flat square (qhull cannot take it) comes back whole, flagged."""
+    from kcplan.geometry.enclosing import convex_hull_vertices
+
+    grid = np.array(np.meshgrid(*[[0.0, 0.5, 1.0]] * 3, indexing="ij")).reshape(3, -1).T
+    V, full = convex_hull_vertices(grid)
+    corners = grid[np.all((grid == 0.0) | (grid == 1.0), axis=1)]
+    assert full and V.shape == (8, 3)
+    np.testing.assert_array_equal(V, corners)
+    flat = grid[grid[:, 2] == 0.0]
+    V, full = convex_hull_vertices(flat)
+    assert not full
+    np.testing.assert_array_equal(V, flat)
+
+
 def test_an_mvee_told_its_points_are_hull_vertices_is_the_same():
     """`hull_vertices=True` skips qhull; given the hull's vertices it is the same fit."""
     from scipy.spatial import ConvexHull

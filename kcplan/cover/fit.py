@@ -76,10 +76,11 @@ from kcplan.cover.partition import Piece, clip_simplices
 from kcplan.cover.solid import Solid
 from kcplan.geometry.enclosing import (
     FLAT_RATIO,
+    convex_hull_vertices,
     ellipsoid_axes,
     ellipsoid_volume,
     enclose,
-    mahalanobis_sq,
+    frame_norm_sq,
     minimum_volume_ellipsoid,
 )
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
@@ -226,10 +227,7 @@ def _hull_vertices(points: NDArray, unique: bool) -> tuple[NDArray, bool]:
     of the vertices it returns, which Khachiyan's tie rule follows, changes with them)."""
     if unique and len(points) > UNIQUE_ABOVE:
         points = _without_repeats(points)
-    try:
-        return points[ConvexHull(points).vertices], True
-    except (QhullError, ValueError):
-        return points, False
+    return convex_hull_vertices(points)
 
 
 def _without_repeats(points: NDArray) -> NDArray:
@@ -373,11 +371,12 @@ class _Scorer:
     def inside(self, center: NDArray, M: NDArray) -> NDArray[np.bool_]:
         """The sample points in the ellipsoid ``(x - c)^T M (x - c) <= 1``; only those in
         its slab along x (half-width ``sqrt((M^-1)_xx)``, padded) are measured."""
-        half = math.sqrt(max(float(np.linalg.inv(M)[0, 0]), 0.0)) * (1.0 + 1e-6)
+        a, R = ellipsoid_axes(M)
+        half = float(np.linalg.norm(R[0] * a)) * (1.0 + 1e-6)  # the support along x
         x = self.points[:, 0]
         lo, hi = np.searchsorted(x, [center[0] - half, center[0] + half], side="left")
         out = np.zeros(len(x), dtype=bool)
-        out[lo : hi + 1] = mahalanobis_sq(self.points[lo : hi + 1], center, M) <= 1.0
+        out[lo : hi + 1] = frame_norm_sq(self.points[lo : hi + 1] - center, a, R) <= 1.0
         return out
 
     def outside(self, M: NDArray, inside: NDArray[np.bool_]) -> float:
@@ -819,11 +818,7 @@ def _offset_cut(search: _Search, meter, leaf: _Leaf, shape: str) -> tuple[NDArra
             points = piece.points(search.solid.boundary)
             if len(piece.boundary) == 0 or len(points) == 0:
                 break
-            try:  # the same ellipsoid holds the points and their hull's corners
-                points = points[ConvexHull(points).vertices]
-            except (QhullError, ValueError):
-                pass
-            c, M = _enclosing(points, shape, SEARCH_TOL)
+            c, M = _enclosing(points, shape, SEARCH_TOL)  # on the points' hull vertices
             body = body_from_ellipsoid(c, M, sphere=shape == "sphere")
             estimates.append(meter.estimate(body, OFFSET_SAMPLES))
         else:

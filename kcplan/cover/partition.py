@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull, QhullError
 
+from kcplan.geometry.enclosing import convex_hull_vertices
 from kcplan.geometry.winding import winding_numbers
 
 __all__ = ["Piece", "clip_simplices", "clip_points"]
@@ -103,10 +103,7 @@ def clip_points(corners: NDArray, normal: NDArray, offset: float) -> NDArray:
     t = di[:, None] / (di[:, None] - dj[None, :])
     crossings = keep[:, None, :] + t[:, :, None] * (drop[None, :, :] - keep[:, None, :])
     points = np.concatenate([keep, crossings.reshape(-1, corners.shape[1])])
-    try:
-        return points[ConvexHull(points).vertices]
-    except (QhullError, ValueError):  # a flat remainder: keep every point (sound)
-        return points
+    return convex_hull_vertices(points)[0]  # a flat remainder: every point (sound)
 
 
 @dataclass(frozen=True, eq=False)

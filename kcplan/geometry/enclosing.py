@@ -27,6 +27,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 __all__ = [
     "ellipsoid_axes",
+    "convex_hull_vertices",
     "ellipsoid_volume",
     "enclose",
     "frame_norm_sq",
@@ -106,6 +107,26 @@ def _flat_ellipsoid(P: NDArray) -> tuple[NDArray, NDArray]:
     return c, Vt.T @ np.diag(1.0 / a**2) @ Vt
 
 
+def convex_hull_vertices(points: ArrayLike) -> tuple[NDArray[np.float64], bool]:
+    """The vertices of the points' convex hull, in the points' order (qhull's), and True;
+    or every point and False when qhull cannot take them (a flat set, too few points).
+
+    Parameters
+    ----------
+    points : array_like, shape (m, n)
+
+    Returns
+    -------
+    vertices : ndarray, shape (k, n)
+    full : bool
+    """
+    P = np.asarray(points, dtype=float)
+    try:
+        return P[ConvexHull(P).vertices], True
+    except (QhullError, ValueError):
+        return P, False
+
+
 def minimum_volume_ellipsoid(
     points: ArrayLike,
     tol: float = 1e-3,
@@ -149,10 +170,9 @@ def minimum_volume_ellipsoid(
     spread = np.linalg.svd(P - P.mean(axis=0), compute_uv=False)
     if len(P) <= n or spread[-1] <= FLAT_RATIO * max(float(spread[0]), 1e-300):
         return _flat_ellipsoid(P)
-    if not hull_vertices:
-        try:  # only hull vertices can touch the MVEE
-            P = P[ConvexHull(P).vertices]
-        except QhullError:
+    if not hull_vertices:  # only hull vertices can touch the MVEE
+        P, full = convex_hull_vertices(P)
+        if not full:
             return _flat_ellipsoid(P)
     origin = P.mean(axis=0)
     X = P - origin
