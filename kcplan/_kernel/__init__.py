@@ -160,6 +160,8 @@ def add_obstacles(world: _core.World, obstacles, n: int) -> None:
             world.add_convex(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
         elif ob.kind == "mesh":
             world.add_mesh(ob.vertices.ravel().tolist(), ob.triangles.ravel().tolist())
+        elif ob.kind in ("pointcloud", "depth"):  # extents: the planning radius
+            world.add_points(np.ascontiguousarray(ob.vertices, dtype=float), float(ob.extents[0]))
         else:  # pragma: no cover - the scenario loader knows no other kind
             raise ValueError(f"{ob.label}: unknown obstacle kind {ob.kind!r}")
 

@@ -52,6 +52,16 @@ nb::dict world_counters(const kcplan::World& w) {
   return d;
 }
 
+nb::dict cloud_counters(const kcplan::World& w) {
+  const kcplan::CloudCounters c = w.cloud_counters();
+  nb::dict d;
+  d["queries"] = c.queries;
+  d["nodes"] = c.nodes;
+  d["points"] = c.points;
+  d["exact"] = c.exact;
+  return d;
+}
+
 nb::dict certifier_counters(const kcplan::CertifierCounters& c) {
   nb::dict d;
 #define KC_COUNTER(name) d[#name] = c.name
@@ -129,6 +139,12 @@ NB_MODULE(_core, m) {
       .def("add_cylinder", &kcplan::World::add_cylinder, "centre"_a, "rotation"_a, "radius"_a,
            "half_height"_a)
       .def("add_mesh", &kcplan::World::add_mesh, "vertices"_a, "triangles"_a)
+      .def(
+          "add_points",
+          [](kcplan::World& w,
+             nb::ndarray<const double, nb::shape<-1, 3>, nb::c_contig, nb::device::cpu> points,
+             double radius) { w.add_points(points.data(), points.shape(0), radius); },
+          "points"_a, "radius"_a)
       .def("finalize", &kcplan::World::finalize)
       .def_prop_ro("n_objects", &kcplan::World::n_objects)
       .def_prop_ro("dimension", [](const kcplan::World& w) { return w.robot().dimension(); })
@@ -178,9 +194,11 @@ NB_MODULE(_core, m) {
       .def("ball_collides", &kcplan::World::ball_collides, "centre"_a, "radius"_a)
       .def("sweep_core_collides", &kcplan::World::sweep_core_collides, "a"_a, "b"_a, "radius"_a)
       .def_prop_ro("counters", &world_counters)
+      .def_prop_ro("cloud_counters", &cloud_counters)
       .def_prop_ro("body_query_counts", [](const kcplan::World& w) { return w.body_query_counts; })
       .def("reset_counters", [](kcplan::World& w) {
         w.counters = kcplan::WorldCounters{};
+        w.reset_cloud_counters();
         std::fill(w.body_query_counts.begin(), w.body_query_counts.end(), 0);
       });
 

@@ -125,6 +125,7 @@ struct World::CollideNear : coal::CollisionCallBackBase {
   coal::CollisionResult result;
   bool collide(coal::CollisionObject* o1, coal::CollisionObject* o2) override {
     coal::CollisionObject* obstacle = o1 == query ? o2 : o1;
+    if (PointCloud* cloud = world->cloud_of(*obstacle)) return hit = cloud->collides(*query);
     bool exact;
     if (support.gap(*world, *obstacle, exact) > 0.0)
       return false;  // separated from the box, ball or cylinder along one line
@@ -167,7 +168,8 @@ struct World::DistanceNear : coal::DistanceCallBackBase {
       if (exact && gap > 0.0)
         best = std::min(best, gap);
       else if (gap < best)
-        best = std::min(best, world->pair_distance(*query, shape, *obstacle, request, result));
+        best = std::min(best,
+                        world->pair_distance(*query, shape, *obstacle, request, result, best));
     }
     dist = best;
     return best <= 0.0;
@@ -247,6 +249,7 @@ void World::add(const std::shared_ptr<coal::CollisionGeometry>& geometry,
   supports_.push_back(std::move(support));
   primitives_.push_back(primitive);
   planes_.emplace_back();
+  clouds_.emplace_back();
   objects_.push_back(std::move(object));
 }
 
@@ -382,6 +385,29 @@ void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>
   if (planes->usable()) planes_.back() = std::move(planes);
 }
 
+void World::add_points(const double* xyz, std::size_t n, double radius) {
+  if (dimension_ != 3) throw std::invalid_argument("point cloud: a 3D obstacle");
+  auto cloud = std::make_unique<PointCloud>(xyz, n, radius);
+  // the broad phase sees the cloud's box; its narrow phase is the cloud's own
+  const coal::AABB& box = cloud->bounds();
+  const Vec3s side = box.max_ - box.min_;
+  add(std::make_shared<coal::Box>(side[0], side[1], side[2]),
+      coal::Transform3s(coal::Matrix3s::Identity(), box.center()), Support{});
+  clouds_.back() = std::move(cloud);
+}
+
+CloudCounters World::cloud_counters() const {
+  CloudCounters sum;
+  for (const auto& cloud : clouds_)
+    if (cloud) {
+      sum.queries += cloud->counters.queries;
+      sum.nodes += cloud->counters.nodes;
+      sum.points += cloud->counters.points;
+      sum.exact += cloud->counters.exact;
+    }
+  return sum;
+}
+
 void World::finalize() {
   if (finalized_) return;
   std::vector<coal::CollisionObject*> raw;
@@ -437,7 +463,8 @@ bool World::collides(coal::CollisionObject& object, std::size_t shape) {
 
 double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
                             coal::CollisionObject& obstacle, coal::DistanceRequest& request,
-                            coal::DistanceResult& result) {
+                            coal::DistanceResult& result, double cap) {
+  if (PointCloud* cloud = cloud_of(obstacle)) return cloud->distance(object, cap);
   if (const auto bound = plane_bound(object, obstacle, true);
       bound && bound->value > 0.0 && bound->exact)
     return bound->value;
@@ -635,7 +662,9 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
         continue;
       }
     }
-    const double d = pair_distance(body, k, *obstacle, request, result);
+    // a cloud is measured up to the horizon only: past it, its plane says nothing more
+    const double d = pair_distance(body, k, *obstacle, request, result,
+                                   (horizon + atol_) / (1.0 - rtol_));
     if (!(d > 0.0)) {
       region.planes.clear(), region.horizon = 0.0;
       return false;

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -15,6 +16,7 @@
 #include <coal/shape/geometric_shapes.h>
 
 #include "mesh_planes.hpp"
+#include "point_cloud.hpp"
 #include "pose.hpp"
 #include "primitive_bound.hpp"
 #include "robot.hpp"
@@ -107,6 +109,11 @@ class World {
                     double radius, double half_height);
   /// A triangle mesh surface (no support function: its pieces keep only clearances).
   void add_mesh(const std::vector<double>& vertices, const std::vector<int>& triangles);
+  /// A point cloud (3D only): the balls of `radius` about n points (`xyz`, n x 3
+  /// row-major), one obstacle whose narrow phase is its PointCloud (its k-d tree, then
+  /// coal's GJK per point that the tree's bounds leave undecided). Like a mesh it has no
+  /// support function: region queries keep only its clearance.
+  void add_points(const double* xyz, std::size_t n, double radius);
   /// Register every obstacle in the broad phase (once, after the last add_*).
   void finalize();
 
@@ -179,6 +186,12 @@ class World {
                            double radius);
 
   const Robot& robot() const { return robot_; }
+  /// The point clouds' work, summed over every cloud.
+  CloudCounters cloud_counters() const;
+  void reset_cloud_counters() {
+    for (auto& cloud : clouds_)
+      if (cloud) cloud->counters = CloudCounters{};
+  }
   std::size_t n_objects() const { return objects_.size(); }
   double atol() const { return atol_; }
   double rtol() const { return rtol_; }
@@ -225,9 +238,15 @@ class World {
   double distance(coal::CollisionObject& object, std::size_t shape);
   /// The distance of one pair (0 for an overlap or what coal cannot tell), warm-started;
   /// `result` keeps coal's nearest points.
+  /// A point cloud is measured up to `cap` only (past it: `cap`, or more).
   double pair_distance(coal::CollisionObject& object, std::size_t shape,
                        coal::CollisionObject& obstacle, coal::DistanceRequest& request,
-                       coal::DistanceResult& result);
+                       coal::DistanceResult& result,
+                       double cap = std::numeric_limits<double>::infinity());
+  /// The obstacle's point cloud, or null when it is not one.
+  PointCloud* cloud_of(const coal::CollisionObject& obstacle) const {
+    return clouds_[reinterpret_cast<std::size_t>(obstacle.getUserData())].get();
+  }
   WarmStart& warm(std::size_t shape, const coal::CollisionObject& obstacle);
   /// The planes' bound of a mesh obstacle for `query` (MeshPlanes::bound); no value when
   /// the obstacle is not a mesh (or its planes are unusable) or the query shape has no
@@ -254,6 +273,7 @@ class World {
   std::vector<Support> supports_;
   std::vector<Primitive> primitives_;  // per obstacle; kNone: not a box, ball or cylinder
   std::vector<std::unique_ptr<const MeshPlanes>> planes_;  // per obstacle; null: not a mesh
+  std::vector<std::unique_ptr<PointCloud>> clouds_;  // per obstacle; null: not a cloud
   std::vector<std::unique_ptr<coal::CollisionObject>> bodies_;
   std::vector<std::unique_ptr<coal::CollisionObject>> grown_;  // per body, made on first use
   std::vector<char> convex_;  // per body: its shape is set_body_shape's, not the ellipsoid

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
+from functools import cached_property
 
 import fcl
 import numpy as np
@@ -106,23 +107,19 @@ class ArmWorld:
         and that are not proven apart."""
         self._shapes = [_fcl_shape(b) for b in arm.bodies]
         self._bodies = [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
-        self._objects, self._supports, self._nearest, boxes = [], [], [], []
         for ob in self.obstacles:
             if len(ob.center) != 3:
                 raise ValueError(f"{ob.label}: expected a 3D obstacle for an arm")
-            parts = fcl_obstacle_parts(ob, 3)
-            for (geometry, tf), support in zip(parts, piece_supports(ob), strict=True):
-                self._objects.append(fcl.CollisionObject(geometry, tf))
-                self._supports.append(support)
-                self._nearest.append(_nearest_point(ob) if len(parts) == 1 else None)
-                boxes.append(_box(ob, support))
-        self._boxes = np.array(boxes).reshape(-1, 2, 3)
-        self._manager = fcl.DynamicAABBTreeCollisionManager()
-        if self._objects:
-            self._manager.registerObjects(self._objects)
-            self._manager.setup()
         if size is None:
-            corners = [ob.center for ob in self.obstacles] or [np.zeros(3)]
+            corners = [
+                corner
+                for ob in self.obstacles
+                for corner in (
+                    (ob.vertices.min(axis=0), ob.vertices.max(axis=0))
+                    if ob.kind in ("pointcloud", "depth")
+                    else (ob.center,)
+                )
+            ] or [np.zeros(3)]
             size = max(2.0, float(np.ptp(np.array(corners), axis=0).max()))
         self.size = float(size)
         """Size of the scene in metres (the error allowances' scale)."""
@@ -130,6 +127,31 @@ class ArmWorld:
         self._fcl_counters = {"collision_queries": 0, "distance_queries": 0}
         self._request = fcl.DistanceRequest(enable_nearest_points=True)
         self._kernel = None
+
+    @cached_property
+    def _scene(self) -> tuple:
+        """The obstacles' FCL objects, support functions, nearest-point functions, boxes
+        and broad phase, made on first use: a planner on the compiled kernel never asks
+        (a point cloud of 10^5 points would otherwise cost a second of FCL objects)."""
+        objects, supports, nearest, boxes = [], [], [], []
+        for ob in self.obstacles:
+            parts = fcl_obstacle_parts(ob, 3)
+            for (geometry, tf), support in zip(parts, piece_supports(ob), strict=True):
+                objects.append(fcl.CollisionObject(geometry, tf))
+                supports.append(support)
+                nearest.append(_nearest_point(ob) if len(parts) == 1 else None)
+                boxes.append(_box(ob, support))
+        manager = fcl.DynamicAABBTreeCollisionManager()
+        if objects:
+            manager.registerObjects(objects)
+            manager.setup()
+        return objects, supports, nearest, np.array(boxes).reshape(-1, 2, 3), manager
+
+    _objects = property(lambda self: self._scene[0])
+    _supports = property(lambda self: self._scene[1])
+    _nearest = property(lambda self: self._scene[2])
+    _boxes = property(lambda self: self._scene[3])
+    _manager = property(lambda self: self._scene[4])
 
     @property
     def kernel(self):

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import os
+from functools import cached_property
 
 import fcl
 import numpy as np
@@ -119,6 +120,9 @@ def fcl_obstacle_parts(ob: Obstacle, n: int, half_height: float = 1.0) -> list[t
     if ob.kind == "convex":
         faces = np.column_stack([np.full(len(ob.triangles), 3), ob.triangles]).ravel()
         return [(fcl.Convex(ob.vertices, len(ob.triangles), faces.astype(np.int32)), identity)]
+    if ob.kind in ("pointcloud", "depth"):  # each point a ball of the planning radius
+        radius = float(ob.extents[0])  # a geometry each: supports are keyed by geometry
+        return [(fcl.Sphere(radius), fcl.Transform(p)) for p in ob.vertices]
     if ob.kind == "mesh":
         model = fcl.BVHModel()
         model.beginModel(len(ob.vertices), len(ob.triangles))
@@ -185,20 +189,6 @@ class CollisionWorld:
         ]
         self._single = robot.is_single
         self._half_height = float(max(robot.largest_semi_axis, 1.0))
-        self._objects: list[fcl.CollisionObject] = []
-        self.owner: list[int] = []  # obstacle index of each FCL object
-        # id of an FCL geometry -> the exact support function of its piece, or None
-        self._support_of: dict[int, object] = {}
-        for ob in scenario.obstacles:
-            parts = fcl_obstacle_parts(ob, n, self._half_height)
-            for (geom, tf), support in zip(parts, piece_supports(ob), strict=True):
-                self._support_of[id(geom)] = support
-                self._objects.append(fcl.CollisionObject(geom, tf))
-                self.owner.append(ob.index)
-        self._manager = fcl.DynamicAABBTreeCollisionManager()
-        if self._objects:
-            self._manager.registerObjects(self._objects)
-            self._manager.setup()
         self._pose_size = pose_size(n)
         self.clearance_atol = CLEARANCE_ATOL * float(
             max(np.ptp(scenario.bounds, axis=0).max(), robot.reach)
@@ -214,6 +204,30 @@ class CollisionWorld:
             "body_queries": 0,
         }
         self._fcl_body_counts = [0] * len(robot.bodies)
+
+    @cached_property
+    def _scene(self) -> tuple:
+        """The obstacles' FCL objects, the obstacle index of each, the support function of
+        each FCL geometry (by id; None where a piece has none) and the broad phase, made on
+        first use: a planner on the compiled kernel never asks (a point cloud of 10^5
+        points would otherwise cost a second of FCL objects)."""
+        objects, owner, support_of = [], [], {}
+        for ob in self.scenario.obstacles:
+            parts = fcl_obstacle_parts(ob, self.dimension, self._half_height)
+            for (geom, tf), support in zip(parts, piece_supports(ob), strict=True):
+                support_of[id(geom)] = support
+                objects.append(fcl.CollisionObject(geom, tf))
+                owner.append(ob.index)
+        manager = fcl.DynamicAABBTreeCollisionManager()
+        if objects:
+            manager.registerObjects(objects)
+            manager.setup()
+        return objects, owner, support_of, manager
+
+    _objects = property(lambda self: self._scene[0])
+    owner = property(lambda self: self._scene[1], doc="The obstacle index of each FCL object.")
+    _support_of = property(lambda self: self._scene[2])
+    _manager = property(lambda self: self._scene[3])
 
     @property
     def counters(self) -> dict[str, int]:

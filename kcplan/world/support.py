@@ -127,6 +127,8 @@ def piece_supports(obstacle) -> list:
         return [PointsSupport(box_vertices(obstacle.center, obstacle.rotation, obstacle.extents))]
     if kind in ("circle", "sphere"):
         return [BallSupport(obstacle.center, obstacle.extents[0])]
+    if kind in ("pointcloud", "depth"):
+        return [BallSupport(p, obstacle.extents[0]) for p in obstacle.vertices]
     if kind in ("ellipse", "ellipsoid"):
         return [EllipsoidSupport(obstacle.center, obstacle.rotation, obstacle.extents)]
     if kind == "cylinder":  # extents (r, r, h / 2)

@@ -1,0 +1,173 @@
+#include "point_cloud.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include <coal/collision.h>
+#include <coal/distance.h>
+
+#include "coal_requests.hpp"
+
+namespace kcplan {
+
+using coal::Vec3s;
+
+/// One query's shape and what the bounds need of it: its support, found once, and the
+/// planes {x : n . x <= h} holding it that GJK's nearest points have shown so far.
+struct PointCloud::Query {
+  static constexpr int kPlanes = 4;
+  const coal::CollisionObject* object;
+  const coal::AABB* box;
+  ShapeSupport support;
+  bool supported;
+  double scale;  // of the numbers in a bound, for its rounding allowance
+  Vec3s normals[kPlanes];
+  double offsets[kPlanes];
+  int planes = 0, next = 0;
+
+  bool ball;  // the shape is a ball: a point's bound along the centres' line is exact
+
+  explicit Query(const coal::CollisionObject& o)
+      : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)) {
+    scale = 1.0 + support.centre.norm() + std::abs(support.spread_high);
+    ball = supported && support.hull == nullptr && !support.capsule &&
+           support.spread_low == support.spread_high;
+  }
+
+  /// Keep the plane across unit `n` that touches the shape (its support there).
+  void add_plane(const Vec3s& n) {
+    if (!supported) return;
+    normals[next] = n;
+    offsets[next] = n.dot(support.centre) + support.spread(n);
+    next = (next + 1) % kPlanes;
+    planes = std::min(planes + 1, kPlanes);
+  }
+
+  /// A lower bound of the distance from the shape to any point of the box about `m` of
+  /// half sides `half` (a point: half = 0), less rounding; -inf when nothing is known.
+  double bound(const Vec3s& m, const Vec3s& half) const {
+    double best = -std::numeric_limits<double>::infinity();
+    if (!supported) return best;
+    // each kept plane: the shape lies in {n . x <= h}, the box in {n . y >= n . m - |n| . half}
+    for (int j = 0; j < planes; ++j)
+      best = std::max(best, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
+    const Vec3s d = m - support.centre;
+    const double length = d.norm();
+    if (length > 0.0) best = std::max(best, length - support.spread(d / length) - half.norm());
+    return best - 1e-12 * (scale + m.norm() + half.norm());
+  }
+};
+
+PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, std::size_t leaf_size)
+    : radius_(radius) {
+  if (n == 0) throw std::invalid_argument("point cloud: expected at least one point");
+  if (n >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("point cloud: too many points");
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw std::invalid_argument("point cloud: expected a finite radius > 0");
+  if (leaf_size == 0) leaf_size = 1;
+  points_.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw std::invalid_argument("point cloud: expected finite coordinates");
+    points_.emplace_back(p[0], p[1], p[2]);
+  }
+  nodes_.reserve(4 * (n / leaf_size + 1));
+  nodes_.resize(1);
+  build(0, 0, static_cast<std::uint32_t>(n), leaf_size);
+  const Node& root = nodes_[0];
+  const Vec3s grow = root.half + Vec3s::Constant(radius_);
+  bounds_ = coal::AABB(root.centre - grow, root.centre + grow);
+  ball_ = std::make_shared<coal::Sphere>(radius_);
+}
+
+void PointCloud::build(std::size_t index, std::uint32_t begin, std::uint32_t end,
+                       std::size_t leaf_size) {
+  Vec3s lo = points_[begin], hi = points_[begin];
+  for (std::uint32_t i = begin + 1; i < end; ++i) {
+    lo = lo.cwiseMin(points_[i]);
+    hi = hi.cwiseMax(points_[i]);
+  }
+  nodes_[index] = Node{0.5 * (lo + hi), 0.5 * (hi - lo), begin, end, -1};
+  if (end - begin <= leaf_size) return;
+  int axis;
+  (hi - lo).maxCoeff(&axis);
+  const std::uint32_t middle = begin + (end - begin) / 2;
+  std::nth_element(points_.begin() + begin, points_.begin() + middle, points_.begin() + end,
+                   [axis](const Vec3s& a, const Vec3s& b) { return a[axis] < b[axis]; });
+  // the children side by side: left at `left`, right at `left + 1`
+  const std::size_t left = nodes_.size();
+  nodes_.resize(left + 2);
+  nodes_[index].left = static_cast<std::int32_t>(left);
+  build(left, begin, middle, leaf_size);
+  build(left + 1, middle, end, leaf_size);
+}
+
+double PointCloud::exact(Query& q, std::size_t i) {
+  ++counters.exact;
+  coal::DistanceRequest request = distance_request(true);
+  request.gjk_initial_guess = coal::GJKInitialGuess::DefaultGuess;
+  coal::DistanceResult result;
+  const coal::Transform3s at(coal::Matrix3s::Identity(), points_[i]);
+  const double d = coal::distance(q.object->collisionGeometryPtr(), q.object->getTransform(),
+                                  ball_.get(), at, request, result);
+  if (!(d > 0.0)) return 0.0;  // an overlap, or anything coal cannot tell (NaN): contact
+  // the direction from the shape's nearest point towards the ball's: a plane that will
+  // bound the points beside this one (its offset is the shape's exact support)
+  const Vec3s dir = result.nearest_points[1] - result.nearest_points[0];
+  const double length = dir.norm();
+  if (length > 0.0 && std::isfinite(length)) q.add_plane(dir / length);
+  return d;
+}
+
+double PointCloud::search(Query& q, double best, double stop_below) {
+  ++counters.queries;
+  // a node's bound: the larger of the boxes' gap and the separation along the centres
+  auto node_bound = [&](const Node& node) {
+    ++counters.nodes;
+    const coal::AABB box(node.centre - node.half, node.centre + node.half);
+    const double gap = q.box->distance(box);
+    return std::max(gap, q.bound(node.centre, node.half)) - radius_;
+  };
+  stack_.clear();
+  if (node_bound(nodes_[0]) < best) stack_.push_back(0);
+  while (!stack_.empty()) {
+    const Node& node = nodes_[stack_.back()];
+    stack_.pop_back();
+    if (node.left < 0) {
+      for (std::uint32_t i = node.begin; i < node.end; ++i) {
+        ++counters.points;
+        const double bound = q.bound(points_[i], Vec3s::Zero()) - radius_;
+        if (bound >= best) continue;
+        best = std::min(best, q.ball ? std::max(bound, 0.0) : exact(q, i));
+        if (best < stop_below) return best;
+      }
+      continue;
+    }
+    const double a = node_bound(nodes_[node.left]), b = node_bound(nodes_[node.left + 1]);
+    // the nearer child is popped first: pushed last
+    const std::int32_t near = a <= b ? node.left : node.left + 1;
+    const double far_bound = a <= b ? b : a, near_bound = a <= b ? a : b;
+    if (far_bound < best) stack_.push_back(near == node.left ? node.left + 1 : node.left);
+    if (near_bound < best) stack_.push_back(near);
+  }
+  return best;
+}
+
+bool PointCloud::collides(const coal::CollisionObject& shape) {
+  Query q(shape);
+  // a contact within GJK's tolerance counts (as collision_request() counts it)
+  const double within = distance_request(false).gjk_tolerance;
+  return search(q, within, within) < within;
+}
+
+double PointCloud::distance(const coal::CollisionObject& shape, double cap) {
+  Query q(shape);
+  return std::max(search(q, cap, std::numeric_limits<double>::min()), 0.0);
+}
+
+}  // namespace kcplan

@@ -1,0 +1,108 @@
+// A sensed point cloud as one obstacle: every point a ball of one radius, the points in a
+// k-d tree whose boxes bound the distance from a robot-side shape from below.
+// Python twin: kcplan/world/collision.py (each point an fcl.Sphere in the broad phase).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <coal/BV/AABB.h>
+#include <coal/collision_object.h>
+#include <coal/data_types.h>
+#include <coal/shape/geometric_shapes.h>
+
+#include "mesh_planes.hpp"
+
+namespace kcplan {
+
+/// Counts of the work one cloud did, summed over its queries.
+struct CloudCounters {
+  std::int64_t queries = 0;  ///< collision and distance queries asked of the cloud
+  std::int64_t nodes = 0;    ///< tree nodes whose bound was computed
+  std::int64_t points = 0;   ///< points whose own bound was computed
+  std::int64_t exact = 0;    ///< points measured by coal's GJK (their bound did not decide)
+};
+
+/// The union of the balls of radius `radius()` about the points, as an obstacle.
+///
+/// The points are kept in a k-d tree (median splits along a box's longest side, leaves of
+/// at most `leaf_size` points); each node keeps its points' bounding box. A query shape S
+/// (an ellipsoid, ball, capsule or convex polytope placed by its coal object: what
+/// ShapeSupport describes) is measured against a node by two lower bounds of the distance
+/// from S to any point of the node's box B, and the larger is used:
+///
+///  - the gap between S's world bounding box and B (S lies in its box);
+///  - S's separation along n = (m - c) / |m - c|, c S's centre and m B's centre:
+///    every x of S has n . x <= n . c + spread_S(n) and every y of B has
+///    n . y >= n . m - rho (rho B's half diagonal), so |y - x| >= n . (y - x) >=
+///    |m - c| - spread_S(n) - rho.
+///
+///  - the planes {x : n . x <= h_S(n)} that hold S, one for each direction GJK's nearest
+///    points have given so far in this query (a point of the cloud measured exactly):
+///    every y of B has n . y >= n . m - |n| . half, so |y - x| >= n . m - |n| . half -
+///    h_S(n) (beside a flat patch of points, such as a sensed table top, this is nearly
+///    the distance, where the centres' line is not).
+///
+/// A point p is bounded the same way (rho = 0), and the bound along the centres' line is
+/// the distance itself when S is a ball (then taken as it is, less its rounding
+/// allowance: no GJK). A point whose bound cannot decide the query is measured by coal's
+/// GJK (a sphere of the cloud's radius about p against S), exactly as any other obstacle
+/// is: the distance the cloud returns is then coal's distance to the nearest ball, or a
+/// lower bound proven to be at least the cap asked for. Its error is therefore coal's
+/// alone, and the World's allowance (d (1 - rtol) - atol, kcplan/_kernel/__init__.py)
+/// covers it as for every obstacle; the bounds themselves are exact up to rounding of
+/// order 1e-16 of the numbers involved, of which 1e-12 is subtracted. A shape whose
+/// support is not known is bounded by its box alone, and its candidate points all go to
+/// GJK.
+///
+/// Contract: at least one point, every coordinate finite, radius > 0 and finite
+/// (std::invalid_argument otherwise). Immutable once built, except its counters and GJK
+/// scratch: not thread-safe.
+class PointCloud {
+ public:
+  /// `xyz`: n x 3 row-major coordinates (world frame).
+  PointCloud(const double* xyz, std::size_t n, double radius, std::size_t leaf_size = 8);
+
+  std::size_t size() const { return points_.size(); }
+  double radius() const { return radius_; }
+  /// The box of every ball (the points' box grown by the radius).
+  const coal::AABB& bounds() const { return bounds_; }
+  /// The points in the tree's order (n x 3).
+  const std::vector<coal::Vec3s>& points() const { return points_; }
+  std::size_t nodes() const { return nodes_.size(); }
+
+  /// Whether some ball touches `shape` (at its transform, its AABB computed).
+  bool collides(const coal::CollisionObject& shape);
+  /// min(cap, the distance from `shape` to the nearest ball), 0 on contact; as coal
+  /// measures it (see the class notes). `cap` = inf for the distance itself.
+  double distance(const coal::CollisionObject& shape, double cap);
+
+  CloudCounters counters;
+
+ private:
+  struct Node {
+    coal::Vec3s centre, half;   // the node's box
+    std::uint32_t begin, end;   // its points: points_[begin, end)
+    std::int32_t left = -1;     // children (right = left + 1); -1: a leaf
+  };
+  struct Query;
+
+  /// Fill node `index` (already allocated) with points_[begin, end) and its subtree.
+  void build(std::size_t index, std::uint32_t begin, std::uint32_t end, std::size_t leaf_size);
+  /// GJK's distance from the query shape to the ball about point i (<= 0: contact).
+  double exact(Query& q, std::size_t i);
+  /// min(best, the distance to the nearest ball), depth first, the nearer child first;
+  /// returns as soon as a ball nearer than `stop_below` is found.
+  double search(Query& q, double best, double stop_below);
+
+  std::vector<coal::Vec3s> points_;
+  std::vector<Node> nodes_;
+  double radius_;
+  coal::AABB bounds_;
+  std::shared_ptr<coal::Sphere> ball_;
+  std::vector<std::int32_t> stack_;
+};
+
+}  // namespace kcplan

@@ -1,0 +1,134 @@
+"""The kernel's point cloud (kcplan/_kernel/point_cloud.hpp): its k-d tree's bounds decide
+which points coal measures, so its answers must be those of measuring every point.
+
+Each case compares a world holding the cloud with brute force over every point: coal's
+distance from the body to each point's ball (the same narrow phase, no tree), and, free of
+coal, the distances from points sampled densely on the body's surface (never below the
+body's distance) and the exact distance of a ball query."""
+
+import coal
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from kcplan._kernel import Robot as KernelRobot
+from kcplan._kernel import World as KernelWorld
+
+SURFACE = 4000
+
+
+def _unit(n: int) -> np.ndarray:
+    """n nearly even unit vectors (a Fibonacci lattice), shape (n, 3)."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    phi = np.pi * (1.0 + 5**0.5) * i
+    r = np.sqrt(1.0 - z * z)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+
+
+UNIT = _unit(SURFACE)
+
+
+def _world(points: np.ndarray, radius: float, axes) -> KernelWorld:
+    world = KernelWorld(KernelRobot(3, list(map(float, axes)), [0, 0, 0, 0, 0, 0, 1]), 1.0, 0, 0)
+    world.add_points(np.ascontiguousarray(points, dtype=float), radius)
+    world.finalize()
+    return world
+
+
+def _coal_distances(points, radius, axes, pose) -> np.ndarray:
+    """coal's distance from the ellipsoid at `pose` to each point's ball (no tree)."""
+    body = coal.Ellipsoid(*map(float, axes))
+    R = Rotation.from_quat(pose[3:]).as_matrix()
+    at = coal.Transform3s(R, np.asarray(pose[:3], dtype=float))
+    ball = coal.Sphere(radius)
+    out = np.empty(len(points))
+    for i, p in enumerate(points):
+        result = coal.DistanceResult()
+        d = coal.distance(body, at, ball, coal.Transform3s(np.eye(3), p), coal.DistanceRequest(),
+                          result)  # fmt: skip
+        out[i] = max(d, 0.0)
+    return out
+
+
+@st.composite
+def clouds(draw):
+    f = st.floats
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    n = draw(st.integers(1, 400))
+    kind = draw(st.sampled_from(("blob", "plane", "shell")))
+    if kind == "blob":
+        points = rng.normal(scale=draw(f(0.05, 1.0)), size=(n, 3))
+    elif kind == "plane":
+        points = np.column_stack([rng.uniform(-1, 1, (n, 2)), np.full(n, draw(f(-0.6, 0.6)))])
+    else:
+        points = draw(f(0.3, 1.5)) * _unit(n)
+    points = points + rng.uniform(-0.3, 0.3, 3)
+    radius = draw(f(1e-4, 0.05))
+    axes = [draw(f(0.02, 0.4)) for _ in range(3)]
+    position = rng.uniform(-0.8, 0.8, 3)
+    q = Rotation.random(random_state=rng.integers(2**31)).as_quat()
+    return points, radius, axes, [*position, *q]
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(clouds())
+def test_the_tree_finds_what_measuring_every_point_finds(case):
+    points, radius, axes, pose = case
+    world = _world(points, radius, axes)
+    brute = _coal_distances(points, radius, axes, pose)
+    (d,) = world.body_distances(pose)
+    # coal's GJK stops within 1e-6 relative above the distance; a ball's is exact
+    assert brute.min() * (1.0 - 2e-6) - 1e-9 <= d <= brute.min() + 1e-9
+    # the verdict: contact exactly where some ball is within GJK's tolerance of the body
+    assert world.in_collision(pose) == bool(brute.min() < 1e-6)
+    # the tree bounded most points without measuring them
+    counters = world.cloud_counters
+    assert counters["exact"] <= counters["points"] <= 2 * len(points) + 16
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(clouds())
+def test_distances_never_exceed_the_bodys_surface_samples(case):
+    """Free of coal: every sampled point of the ellipsoid's surface is at least as far
+    from each ball as the body is, so the smallest of those distances bounds the body's
+    from above; the kernel's answer must not exceed it."""
+    points, radius, axes, pose = case
+    world = _world(points, radius, axes)
+    R = Rotation.from_quat(pose[3:]).as_matrix()
+    surface = pose[:3] + (UNIT * axes) @ R.T
+    gaps = np.linalg.norm(surface[:, None, :] - points[None, :, :], axis=2).min() - radius
+    (d,) = world.body_distances(pose)
+    assert d <= max(gaps, 0.0) + 1e-9
+
+
+@settings(max_examples=100, deadline=None)
+@given(clouds(), st.floats(0.01, 0.5))
+def test_a_ball_is_measured_exactly(case, ball):
+    """A ball's bound along the centres' line is its distance: no GJK at all."""
+    points, radius, _, pose = case
+    world = _world(points, radius, [ball] * 3)
+    centre = np.asarray(pose[:3])
+    exact = max(np.linalg.norm(points - centre, axis=1).min() - radius - ball, 0.0)
+    (d,) = world.body_distances(pose)
+    assert d == pytest.approx(exact, abs=1e-9)
+    assert world.ball_collides(centre.tolist(), ball) == bool(exact < 1e-6)
+
+
+def test_bad_clouds_are_refused_with_a_message():
+    robot = KernelRobot(3, [0.1, 0.1, 0.1], [0, 0, 0, 0, 0, 0, 1])
+    world = KernelWorld(robot, 1.0, 0, 0)
+    with pytest.raises(ValueError, match="at least one point"):
+        world.add_points(np.zeros((0, 3)), 0.01)
+    with pytest.raises(ValueError, match="finite coordinates"):
+        world.add_points(np.array([[0.0, np.nan, 0.0]]), 0.01)
+    with pytest.raises(ValueError, match="radius"):
+        world.add_points(np.zeros((2, 3)), 0.0)
+    with pytest.raises(TypeError):  # not n x 3
+        world.add_points(np.zeros((2, 2)), 0.01)
+    planar = KernelWorld(KernelRobot(2, [0.1, 0.1], [0, 0, 0]), 1.0, 0, 0)
+    with pytest.raises(ValueError, match="3D"):
+        planar.add_points(np.zeros((2, 3)), 0.01)
