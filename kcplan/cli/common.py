@@ -10,6 +10,7 @@ import numpy as np
 __all__ = [
     "InputError",
     "Parser",
+    "duration",
     "finite_float",
     "load_input",
     "non_negative_float",
@@ -101,3 +102,12 @@ def planner_name(text: str) -> str:
         return check_planner_name(text)
     except ValueError as err:
         raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def duration(seconds: float) -> str:
+    """A time in a unit that shows it: ``"3.20 s"``, ``"12.3 ms"``, ``"85 us"``."""
+    if seconds >= 1.0:
+        return f"{seconds:.2f} s"
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds * 1e6:.3g} us"

@@ -6,7 +6,14 @@ import argparse
 import json
 import math
 
-from kcplan.cli.common import InputError, load_input, output_file, planner_name, positive_float
+from kcplan.cli.common import (
+    InputError,
+    duration,
+    load_input,
+    output_file,
+    planner_name,
+    positive_float,
+)
 
 
 def _print_counters(counters: dict) -> None:
@@ -68,11 +75,15 @@ def run(args: argparse.Namespace) -> int:
                   acceleration_limits=acceleration)  # fmt: skip
     status = "solved" if result.solved else "NOT solved"
     print(
-        f"{scenario.name}: {status} by {args.planner} in {result.time:.3f} s "
-        f"(simplification {result.simplify_time:.3f} s)"
+        f"{scenario.name}: {status} by {args.planner} in {duration(result.time)} "
+        f"(simplification {duration(result.simplify_time)})"
     )
     if result.solved:
         print(f"path            : {len(result.states)} states, length {result.length:.4g}")
+    for ob in scenario.obstacles:
+        if getattr(ob, "cloud", None) is not None:
+            print(f"{ob.label:<16}: {ob.cloud.summary()}")
+    print("time split      : " + ", ".join(f"{k} {duration(v)}" for k, v in result.timing.items()))
     _print_counters(result.counters)
     if args.output:
         from kcplan.files import write_text_atomic

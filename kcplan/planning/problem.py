@@ -331,6 +331,11 @@ class PlanResult:
     joints: tuple[str, ...] | None = None
     """An arm's planning group: ``states`` are joint vectors in this order (else None:
     flat poses)."""
+    timing: dict = field(default_factory=dict)
+    """Where the time went, in seconds: ``read`` and ``filter`` (the scenario's point
+    clouds and depth images: reading, cropping, voxel and self filters), ``build`` (the
+    collision world, its compiled twin with every cloud's tree, and the validator),
+    ``plan`` (:attr:`time`) and ``simplify`` (:attr:`simplify_time`)."""
     trajectory: object = field(default=None, repr=False, compare=False)
     """The timed trajectory along the path when :func:`plan` was asked for it
     (``trajectory=True``): an arm's :class:`kcplan.planning.trajectory.CertifiedTrajectory`,
@@ -373,6 +378,7 @@ class PlanResult:
             "first_solution_time": self.first_solution_time,
             "progress": self.progress,
             "backend": self.backend,
+            "timing": self.timing,
         }
 
 
@@ -458,7 +464,9 @@ def plan(
     if seed is not None:
         seed_ompl(seed)
     checker_calls = [0]
+    built = time.perf_counter()
     setup = setup_for(scenario, spec, world)
+    built = time.perf_counter() - built
     space, ss, si, validator = setup.space, setup.ss, setup.si, setup.validator
 
     def is_valid(state) -> bool:
@@ -573,8 +581,22 @@ def plan(
         recorder.first_solution_time if recorder is not None else None,
         setup.backend,
         setup.joints,
-        timed,
+        trajectory=timed,
+        timing={**sensed_times(scenario.obstacles), "build": built, "plan": solve_time,
+                "simplify": simplify_time},
     )
+
+
+def sensed_times(obstacles) -> dict[str, float]:
+    """Seconds spent reading and filtering the point clouds and depth images among
+    ``obstacles`` (:class:`kcplan.world.pointcloud.CloudInfo`; empty without any)."""
+    infos = [ob.cloud for ob in obstacles if getattr(ob, "cloud", None) is not None]
+    if not infos:
+        return {}
+    return {
+        "read": sum(info.read_seconds for info in infos),
+        "filter": sum(info.filter_seconds for info in infos),
+    }
 
 
 _QUERY_KINDS = ("collision_queries", "distance_queries", "region_queries")
