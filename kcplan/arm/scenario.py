@@ -49,13 +49,16 @@ from numpy.typing import NDArray
 
 from kcplan.arm.attach import Attached, attach
 from kcplan.arm.examples import example_robot
+from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
+from kcplan.world.pointcloud import ellipsoid_self_filter_mask, hull_self_filter_mask
 from kcplan.world.scenario import (
     MAX_OBSTACLES,
     FieldReader,
     Obstacle,
     ScenarioError,
     parse_obstacle,
+    self_filtered,
 )
 
 __all__ = ["ArmScenario", "arm_scenario_to_dict", "parse_arm_scenario"]
@@ -215,11 +218,35 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             obstacles.append(_cylinder(r, item["cylinder"], i))
         else:
             obstacles.append(parse_obstacle(r, item, i, 3, directory))
+    obstacles = [
+        self_filtered(r, ob, lambda pts, pad: links_mask(arm, start, pts, pad)) for ob in obstacles
+    ]
     allowed = _allowed(r, top.get("allowed") or [])
     return ArmScenario(
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
         description, source, directory,
     )  # fmt: skip
+
+
+def links_mask(arm: ArmModel, state: NDArray, points: NDArray, padding: float) -> NDArray:
+    """The points within ``padding`` of the arm's bodies at ``state``: each link's hull (and
+    an attached part's), or its covering ellipsoids (the self filter of sensed clouds)."""
+    frames = body_frames(arm, state)
+    on_robot = np.zeros(len(points), dtype=bool)
+    hulls = [
+        (b.hull.vertices @ f[:3, :3].T + f[:3, 3], b.hull.triangles)
+        for b, f in zip(arm.bodies, frames, strict=True)
+        if b.hull is not None
+    ]
+    if hulls:
+        on_robot |= hull_self_filter_mask(points, hulls, padding)
+    covered = [k for k, b in enumerate(arm.bodies) if b.hull is None]
+    if covered:
+        on_robot |= ellipsoid_self_filter_mask(
+            points, frames[covered, :3, 3], frames[covered, :3, :3],
+            np.stack([arm.bodies[k].semi_axes for k in covered]), padding,
+        )  # fmt: skip
+    return on_robot
 
 
 def _attached(r: FieldReader, value: Any, directory: Path) -> list[Attached]:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -46,6 +46,7 @@ from kcplan.world.pointcloud import (
     crop_box_mask,
     crop_sphere_mask,
     drop_nonfinite,
+    ellipsoid_self_filter_mask,
     read_depth_image,
     read_point_file,
     unproject_depth,
@@ -68,6 +69,7 @@ __all__ = [
     "as_rigid_scenario",
     "is_arm_data",
     "parse_obstacle",
+    "self_filtered",
     "parse_rigid_scenario",
     "read_scenario_data",
     "scenario_to_dict",
@@ -698,6 +700,11 @@ def parse_rigid_scenario(
     if len(items) > MAX_OBSTACLES:
         r.fail("obstacles", f"at most {MAX_OBSTACLES} obstacles", None, f"{len(items)}")
     obstacles = tuple(parse_obstacle(r, item, i, n, directory) for i, item in enumerate(items))
+    if n == 3:
+        obstacles = tuple(
+            self_filtered(r, ob, lambda pts, pad: _bodies_mask(robot, poses["start"], pts, pad))
+            for ob in obstacles
+        )
     scenario = Scenario(
         name,
         n,
@@ -713,6 +720,41 @@ def parse_rigid_scenario(
         part,
     )
     return scenario
+
+
+def _bodies_mask(robot: Robot, pose: NDArray, points: NDArray, padding: float) -> NDArray:
+    """The points within ``padding`` of the robot's ellipsoids at ``pose`` (3D)."""
+    placed = robot.body_poses(pose)
+    rotations = np.stack([quaternion_matrix(p[3:]) for p in placed])
+    axes = np.stack([b.semi_axes for b in robot.bodies])
+    return ellipsoid_self_filter_mask(points, placed[:, :3], rotations, axes, padding)
+
+
+def self_filtered(r: FieldReader, obstacle: Obstacle, mask_of) -> Obstacle:
+    """``obstacle`` without the points that lie on the robot itself, when it is a sensed
+    cloud whose scenario asks for a self filter (MoveIt's, for the robot at its start).
+
+    ``mask_of(points, padding)`` tells which points lie within ``padding`` of the robot
+    (each robot kind its own: ellipsoids, or an arm's links). The points removed are
+    counted in :attr:`CloudInfo.self_filtered`; a filter that would leave no point is an
+    error on the obstacle's ``self_filter`` field.
+    """
+    info = obstacle.cloud
+    if info is None or info.self_filter is None:
+        return obstacle
+    started = time.perf_counter()
+    on_robot = mask_of(obstacle.vertices, info.self_filter)
+    removed = int(np.count_nonzero(on_robot))
+    if removed == len(obstacle.vertices):
+        r.fail(f"obstacles[{obstacle.index}].{obstacle.kind}.self_filter",
+               "a padding that leaves some point off the robot", None,
+               f"{info.self_filter:g}, within which all {removed:,} points lie")  # fmt: skip
+    seconds = time.perf_counter() - started
+    return replace(
+        obstacle,
+        vertices=np.ascontiguousarray(obstacle.vertices[~on_robot]),
+        cloud=replace(info, self_filtered=removed, filter_seconds=info.filter_seconds + seconds),
+    )
 
 
 def read_scenario_data(path: str | os.PathLike) -> tuple[Any, str, Path]:
