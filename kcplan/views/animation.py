@@ -105,8 +105,9 @@ def animate_arm(
     triangles each) are posed by Pinocchio's forward kinematics at joint vectors
     interpolated along ``states`` (:func:`kcplan.views.arm.joint_path`); the start (green)
     and goal (red) arms stay see-through in place (their collision meshes, coarser), with
-    the tip joint's path. Seen from
-    the side (:func:`kcplan.views.plots.arm_view_angles`).
+    the tip joint's path; a cloud is drawn as its points
+    (:func:`kcplan.views.plots.draw_clouds`). Seen from the side
+    (:func:`kcplan.views.plots.arm_view_angles`).
 
     Parameters
     ----------
@@ -139,6 +140,7 @@ def animate_arm(
         _draw_layers,
         _obstacle_layer,
         arm_view_angles,
+        draw_clouds,
     )
 
     scenario = as_scenario(scenario)
@@ -160,7 +162,8 @@ def animate_arm(
     )
     fig = plt.figure(figsize=(8, 7))
     ax = fig.add_subplot(projection="3d")
-    _arm_limits(ax, points)
+    _arm_limits(ax, points, scenario.obstacles)
+    draw_clouds(ax, scenario.obstacles)  # drawn once: they never move
     ax.view_init(*arm_view_angles(scenario))
     ax.plot(*along[:, tip_joint(arm), :3, 3].T, color="tab:blue", lw=1.0, alpha=0.7)
     ax.set_title(title or scenario.name, fontsize=9)

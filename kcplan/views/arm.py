@@ -346,8 +346,21 @@ def cylinder_mesh(ob, sections: int = 32) -> tuple[NDArray[np.float64], NDArray[
 def obstacle_mesh(ob) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """A 3D obstacle (:class:`kcplan.world.scenario.Obstacle`) as one triangle mesh in the
     world: a box's 12 triangles, a cylinder's (:func:`cylinder_mesh`), a sphere's or an
-    ellipsoid's icosphere, a mesh's or a convex obstacle's own triangles."""
+    ellipsoid's icosphere, a mesh's or a convex obstacle's own triangles. A cloud
+    (``pointcloud``, ``depth``) has none: the views draw its points
+    (:func:`kcplan.views.clouds.cloud_points_for_display`).
+
+    Raises
+    ------
+    ValueError
+        ``ob`` is a cloud.
+    """
     import trimesh
+
+    from kcplan.views.clouds import is_cloud
+
+    if is_cloud(ob):
+        raise ValueError(f"{ob.label}: a cloud is drawn as points, not as a mesh")
 
     if ob.kind in ("mesh", "convex"):
         return np.asarray(ob.vertices, dtype=float), np.asarray(ob.triangles, dtype=np.int64)

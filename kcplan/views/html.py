@@ -1,9 +1,10 @@
 """An interactive 3D view of a scenario and a path, as one self-contained HTML file.
 
 Built with plotly (its offline HTML export embeds plotly.js, so the file works without a
-network): obstacles, the start (green) and goal (red) robots, the path, and the robot
-moving along it with a play button and a slider. 2D scenes are drawn flat in the plane
-z = 0. plotly rather than MeshCat: plotly is released every few weeks and writes a
+network): obstacles (a sensed cloud as its points, thinned for display:
+:mod:`kcplan.views.clouds`), the start (green) and goal (red) robots, the path, and the
+robot moving along it with a play button and a slider. 2D scenes are drawn flat in the
+plane z = 0. plotly rather than MeshCat: plotly is released every few weeks and writes a
 static file; MeshCat's Python package is rarely released and serves its viewer from a
 running server.
 """
@@ -19,6 +20,14 @@ from kcplan.files import write_text_atomic
 from kcplan.geometry.pose import pose_frame
 from kcplan.maps.superquadric import unit_normals
 from kcplan.scenarios import as_scenario
+from kcplan.views.clouds import (
+    CLOUD_COLORMAP,
+    cloud_points_for_display,
+    clouds_of,
+    drawn_extent,
+    is_cloud,
+    sensor_triad,
+)
 from kcplan.views.plots import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
 from kcplan.world.scenario import Obstacle, Scenario
@@ -45,6 +54,9 @@ def _ellipsoid(center, R, axes, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _obstacle_meshes(ob: Obstacle, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The triangle meshes that draw an obstacle; none for a cloud (:func:`_cloud_traces`)."""
+    if is_cloud(ob):
+        return []
     if ob.kind in ("mesh", "convex"):
         return [(ob.vertices, ob.triangles)]
     if ob.kind == "cylinder":
@@ -56,6 +68,41 @@ def _obstacle_meshes(ob: Obstacle, n: int) -> list[tuple[np.ndarray, np.ndarray]
     if ob.kind == "box":
         return [convex_hull(box_vertices(ob.center, ob.rotation, ob.extents))]
     return [_ellipsoid(ob.center, ob.rotation, ob.extents, n)]
+
+
+def _cloud_traces(obstacles) -> tuple[list[go.Scatter3d], list[str]]:
+    """The clouds among ``obstacles`` as plotly traces: each one's points thinned for
+    display (:func:`kcplan.views.clouds.cloud_points_for_display`), size-2 markers
+    coloured by height on one scale for all clouds, named by the label that says how
+    many of its points are drawn; a depth camera's pose as three lines (x red, y green,
+    z = optical axis blue). Returns the traces and the clouds' labels."""
+    clouds = clouds_of(obstacles)
+    if not clouds:
+        return [], []
+    low, high = drawn_extent(clouds, sensors=False)[:, 2]
+    traces, labels = [], []
+    for ob in clouds:
+        points, label = cloud_points_for_display(ob)
+        labels.append(label)
+        marker = {"size": 2, "color": points[:, 2], "colorscale": CLOUD_COLORMAP.capitalize(),
+                  "cmin": low, "cmax": high if high > low else low + 1.0}  # fmt: skip
+        if not traces:  # one colour bar: the scale is shared
+            marker |= {"showscale": True, "colorbar": {"title": {"text": "z"}, "thickness": 12,
+                                                       "len": 0.5}}  # fmt: skip
+        traces.append(
+            go.Scatter3d(x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="markers",
+                         marker=marker, name=label, legendgroup=f"cloud {ob.index}")
+        )  # fmt: skip
+        triad = sensor_triad(ob)
+        if triad is not None:
+            for (a, b), rgb, axis in zip(*triad, "xyz", strict=True):
+                traces.append(
+                    go.Scatter3d(x=[a[0], b[0]], y=[a[1], b[1]], z=[a[2], b[2]], mode="lines",
+                                 line={"color": _hex(rgb), "width": 5}, showlegend=False,
+                                 name=f"obstacles[{ob.index}]: depth camera {axis} axis",
+                                 legendgroup=f"cloud {ob.index}")
+                )  # fmt: skip
+    return traces, labels
 
 
 def _mesh(V: np.ndarray, F: np.ndarray, color: str, opacity: float, name: str) -> go.Mesh3d:
@@ -114,6 +161,8 @@ def scene_figure(
     for ob in scenario.obstacles:
         for V, F in _obstacle_meshes(ob, n):
             traces.append(_mesh(V, F, "#8c8c8c", 0.45 if n == 3 else 0.8, ob.label))
+    clouds, cloud_labels = _cloud_traces(scenario.obstacles)
+    traces += clouds
     traces += _robot(scenario, scenario.start, "#2ca02c", "start")
     traces += _robot(scenario, scenario.goal, "#d62728", "goal")
     figure_frames, steps = [], []
@@ -147,9 +196,10 @@ def scene_figure(
             )  # fmt: skip
     figure = go.Figure(data=traces, frames=figure_frames)
     low, high = scenario.bounds
-    figure.update_layout(
+    figure.update_layout(  # the legend is off: a cloud's count goes in the title
         title=f"{scenario.name}: {scenario.robot.describe()}"
-        + (f" covering {scenario.part.describe()}" if scenario.part is not None else ""),
+        + (f" covering {scenario.part.describe()}" if scenario.part is not None else "")
+        + "".join(f"<br><sup>{label}</sup>" for label in cloud_labels),
         scene={"aspectmode": "data", "xaxis_title": "x", "yaxis_title": "y", "zaxis_title": "z"},
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
         showlegend=False,
@@ -471,7 +521,8 @@ def arm_view_data(
 
 
 def arm_figure(scenario, data: dict, show_cover: bool = False) -> go.Figure:
-    """The plotly figure of an arm's page: the obstacles, and empty traces for the start
+    """The plotly figure of an arm's page: the obstacles (a cloud as its points, named by
+    how many are drawn: :func:`_cloud_traces`), and empty traces for the start
     and goal arms (green, red), the moving arm and its cover that the page's script fills
     from ``data`` (:func:`arm_view_data`); ``data["traces"]`` is set to their indices."""
     traces = []
@@ -480,6 +531,7 @@ def arm_figure(scenario, data: dict, show_cover: bool = False) -> go.Figure:
             trace = _mesh(V, F, "#8c8c8c", 0.45, ob.label)
             trace.update(legendgroup="obstacles", showlegend=not traces, name="obstacles")
             traces.append(trace)
+    traces += _cloud_traces(scenario.obstacles)[0]
     if data["path"]:
         P = np.asarray(data["path"])
         line = {"color": "#1f77b4", "width": 3}

@@ -28,6 +28,7 @@ __all__ = [
     "plot_convex_bound",
     "plot_scenario",
     "draw_scenario",
+    "draw_clouds",
     "path_poses",
     "plot_path",
     "body_shapes",
@@ -147,6 +148,59 @@ def part_at(part, pose) -> np.ndarray:
     return placed if n == 2 else placed[part.faces]
 
 
+def draw_clouds(ax, obstacles, legend: bool = True) -> list:
+    """Draw the sensed obstacles (``pointcloud``, ``depth``) among ``obstacles`` on 3D
+    axes: each cloud's points thinned for display
+    (:func:`kcplan.views.clouds.cloud_points_for_display`) as small dots coloured by
+    height (one colour scale for all clouds), and a depth camera's pose as a triad (x
+    red, y green, z = optical axis blue).
+
+    Parameters
+    ----------
+    ax : Axes3D
+    obstacles : sequence of kcplan.world.scenario.Obstacle
+    legend : bool
+        Add a legend naming each cloud and how many of its points are drawn.
+
+    Returns
+    -------
+    list
+        The scatter artists, one per cloud.
+    """
+    from kcplan.views.clouds import (
+        CLOUD_COLORMAP,
+        cloud_points_for_display,
+        clouds_of,
+        drawn_extent,
+        sensor_triad,
+    )
+
+    clouds = clouds_of(obstacles)
+    if not clouds:
+        return []
+    low, high = drawn_extent(clouds, sensors=False)[:, 2]
+    artists = []
+    for ob in clouds:
+        points, label = cloud_points_for_display(ob)
+        size = float(np.clip(2000.0 / max(len(points), 1), 1.0, 12.0))  # points^2
+        artists.append(
+            ax.scatter(*points.T, c=points[:, 2], cmap=CLOUD_COLORMAP, vmin=low,
+                       vmax=high if high > low else low + 1.0, s=size, marker="o",
+                       linewidths=0, depthshade=False, label=label)
+        )  # fmt: skip
+        triad = sensor_triad(ob)
+        if triad is not None:
+            for segment, colour in zip(*triad, strict=True):
+                ax.plot(*segment.T, color=colour, lw=1.5)
+    if legend:
+        shown = ax.legend(handles=artists, loc="upper left", fontsize=7)
+        for handle in shown.legend_handles:  # one size and a mid-height colour for every cloud
+            handle.set_sizes([16.0])
+            handle.set_array(None)
+            handle.set_facecolor(plt.get_cmap(CLOUD_COLORMAP)(0.5))
+    return artists
+
+
 def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None) -> None:
     """Draw a scenario's obstacles, bounds, start and goal robots on ``ax``.
 
@@ -159,7 +213,8 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
     guards : float, optional
         Also outline the guard ``(1 + guards) a`` of every body at start and goal.
 
-    A mesh robot (``robot.mesh``) is drawn as its part inside its see-through cover.
+    A mesh robot (``robot.mesh``) is drawn as its part inside its see-through cover; a
+    sensed obstacle as its points (:func:`draw_clouds`), the axes grown to show them all.
     """
     n, robot, part = scenario.dimension, scenario.robot, scenario.part
     cover_alpha = 0.5 if part is None else 0.2
@@ -220,8 +275,12 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
         ax.set_xlabel("x")
         ax.set_ylabel("y")
         return
+    from kcplan.views.clouds import drawn_extent, is_cloud
+
     faces, colors = [], []
     for ob in scenario.obstacles:
+        if is_cloud(ob):
+            continue  # draw_clouds
         if ob.kind == "box":
             faces += _box_faces(ob.center, ob.rotation, ob.extents)
             colors += ["0.6"] * 6
@@ -254,11 +313,15 @@ def draw_scenario(ax, scenario: Scenario, poses=(), guards: float | None = None)
                 alpha=0.8 if part is None else cover_alpha,
                 linewidth=0,
             )
+    draw_clouds(ax, scenario.obstacles)
     corners = np.array(np.meshgrid(*zip(low, high, strict=True), indexing="ij")).reshape(3, -1).T
     for i in range(8):
         for j in range(i + 1, 8):
             if np.count_nonzero(corners[i] != corners[j]) == 1:
                 ax.plot(*corners[[i, j]].T, color="0.5", ls="--", lw=0.5)
+    extent = drawn_extent(scenario.obstacles)
+    if extent is not None:  # the bounds are the robot origin's: a cloud may reach past them
+        low, high = np.minimum(low, extent[0]), np.maximum(high, extent[1])
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
     ax.set_zlim(low[2], high[2])
@@ -415,17 +478,22 @@ def arm_view_angles(scenario) -> tuple[float, float]:
     """``(elev, azim)`` in degrees of a side view of an arm's scene: looking across the
     line from the arm's base (the world origin) to the middle of the obstacles, so that
     the arm reaching into them is seen from its side."""
-    centres = [np.asarray(ob.center, dtype=float)[:2] for ob in scenario.obstacles]
+    from kcplan.views.clouds import obstacle_centre
+
+    centres = [obstacle_centre(ob)[:2] for ob in scenario.obstacles]
     towards = np.mean(centres, axis=0) if centres else np.array([1.0, 0.0])
     heading = float(np.degrees(np.arctan2(towards[1], towards[0])))
     return 20.0, heading - 70.0
 
 
 def _obstacle_layer(scenario) -> tuple[np.ndarray, np.ndarray]:
-    """Every obstacle's triangles ``(m, 3, 3)`` and their RGBA, see-through grey."""
+    """Every obstacle's triangles ``(m, 3, 3)`` and their RGBA, see-through grey (not the
+    clouds': :func:`draw_clouds`)."""
     from kcplan.views.arm import obstacle_mesh
+    from kcplan.views.clouds import is_cloud
 
-    corners = [V[F] for V, F in (obstacle_mesh(ob) for ob in scenario.obstacles)]
+    solids = [ob for ob in scenario.obstacles if not is_cloud(ob)]
+    corners = [V[F] for V, F in (obstacle_mesh(ob) for ob in solids)]
     if not corners:
         return np.zeros((0, 3, 3)), np.zeros((0, 4))
     corners = np.concatenate(corners)
@@ -458,8 +526,14 @@ def _draw_layers(ax, layers) -> Poly3DCollection:
     return collection
 
 
-def _arm_limits(ax, points: np.ndarray) -> None:
-    """Axis limits around ``points`` ``(k, 3)`` with equal scales on the three axes."""
+def _arm_limits(ax, points: np.ndarray, obstacles=()) -> None:
+    """Axis limits around ``points`` ``(k, 3)`` and the points of the clouds among
+    ``obstacles``, with equal scales on the three axes."""
+    from kcplan.views.clouds import drawn_extent
+
+    extent = drawn_extent(obstacles)
+    if extent is not None:
+        points = np.vstack([points.reshape(-1, 3), extent])
     low, high = points.min(axis=0), points.max(axis=0)
     pad = 0.03 * float((high - low).max())
     low, high = low - pad, high + pad
@@ -484,9 +558,10 @@ def plot_arm(
     max_faces: int = 600,
     dpi: int = 90,
 ) -> str:
-    """Draw an arm's scene: the obstacles, the arm at its start (green) and goal (red),
-    and with a path ``states`` about ``poses`` arms along it (blue, see-through) and the
-    tip joint's path, from two viewpoints (a side view and from above).
+    """Draw an arm's scene: the obstacles (a cloud as its points, :func:`draw_clouds`),
+    the arm at its start (green) and goal (red), and with a path ``states`` about
+    ``poses`` arms along it (blue, see-through) and the tip joint's path, from two
+    viewpoints (a side view and from above).
 
     Parameters
     ----------
@@ -544,9 +619,10 @@ def plot_arm(
     for i, (e, a) in enumerate(((elev, azim), (65.0, azim + 40.0))):
         ax = fig.add_subplot(1, 2, i + 1, projection="3d")
         _draw_layers(ax, layers)
+        draw_clouds(ax, scenario.obstacles, legend=i == 0)
         if tip_path is not None:
             ax.plot(*tip_path.T, color="tab:blue", lw=1.0)
-        _arm_limits(ax, points)
+        _arm_limits(ax, points, scenario.obstacles)
         ax.view_init(e, a)
     heading = title or scenario.name
     fig.suptitle(f"{heading}\nstart (green), goal (red); links: {source.split(' (')[0]}",
