@@ -30,8 +30,15 @@ struct PointCloud::Query {
 
   bool ball;  // the shape is a ball: a point's bound along the centres' line is exact
 
+  coal::Matrix3s rotation;  // the shape's frame and its box there (coal's aabb_local)
+  Vec3s origin, low, high;
+
   explicit Query(const coal::CollisionObject& o)
       : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)) {
+    rotation = o.getTransform().getRotation();
+    origin = o.getTransform().getTranslation();
+    low = o.collisionGeometryPtr()->aabb_local.min_;
+    high = o.collisionGeometryPtr()->aabb_local.max_;
     scale = 1.0 + support.centre.norm() + std::abs(support.spread_high);
     ball = supported && support.hull == nullptr && !support.capsule &&
            support.spread_low == support.spread_high;
@@ -47,17 +54,32 @@ struct PointCloud::Query {
   }
 
   /// A lower bound of the distance from the shape to any point of the box about `m` of
-  /// half sides `half` (a point: half = 0), less rounding; -inf when nothing is known.
-  double bound(const Vec3s& m, const Vec3s& half) const {
-    double best = -std::numeric_limits<double>::infinity();
-    if (!supported) return best;
-    // each kept plane: the shape lies in {n . x <= h}, the box in {n . y >= n . m - |n| . half}
-    for (int j = 0; j < planes; ++j)
-      best = std::max(best, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
+  /// half sides `half` (a point: half = 0), less rounding, or a number at least `best`
+  /// as soon as one is known (the cheap bounds first: the boxes' gap, the gap to the
+  /// shape's box in its own frame, its bounding ball, the kept planes, and only then the
+  /// support along the centres' line).
+  double bound(const Vec3s& m, const Vec3s& half, double best) const {
+    const double rho = half.norm();
+    const double slack = 1e-12 * (scale + m.norm() + rho);
+    const coal::AABB& b = *box;  // the boxes' gap: the shape lies in its box
+    const Vec3s out = (b.min_ - half - m).cwiseMax(m - half - b.max_).cwiseMax(0.0);
+    double lower = out.norm();
+    if (lower - slack >= best) return lower - slack;
+    // the gap to the shape's own box in its frame (a link's box is far tighter than the
+    // world's box of it when the link lies slanted)
+    const Vec3s local = rotation.transpose() * (m - origin);
+    lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
+    if (lower - slack >= best || !supported) return lower - slack;
     const Vec3s d = m - support.centre;
     const double length = d.norm();
-    if (length > 0.0) best = std::max(best, length - support.spread(d / length) - half.norm());
-    return best - 1e-12 * (scale + m.norm() + half.norm());
+    lower = std::max(lower, length - support.spread_high - rho);  // the shape's ball
+    if (lower - slack >= best) return lower - slack;
+    // each kept plane: the shape lies in {n . x <= h}, the box in {n . y >= n . m - |n| . half}
+    for (int j = 0; j < planes; ++j)
+      lower = std::max(lower, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
+    if (lower - slack >= best) return lower - slack;
+    if (length > 0.0) lower = std::max(lower, length - support.spread(d / length) - rho);
+    return lower - slack;
   }
 };
 
@@ -107,7 +129,7 @@ void PointCloud::build(std::size_t index, std::uint32_t begin, std::uint32_t end
   build(left + 1, middle, end, leaf_size);
 }
 
-double PointCloud::exact(Query& q, std::size_t i) {
+double PointCloud::exact(Query& q, std::size_t i, Vec3s& towards) {
   ++counters.exact;
   coal::DistanceRequest request = distance_request(true);
   request.gjk_initial_guess = coal::GJKInitialGuess::DefaultGuess;
@@ -120,18 +142,21 @@ double PointCloud::exact(Query& q, std::size_t i) {
   // bound the points beside this one (its offset is the shape's exact support)
   const Vec3s dir = result.nearest_points[1] - result.nearest_points[0];
   const double length = dir.norm();
-  if (length > 0.0 && std::isfinite(length)) q.add_plane(dir / length);
+  if (length > 0.0 && std::isfinite(length)) {
+    q.add_plane(dir / length);
+    towards = -dir / length;
+  } else {
+    towards.setZero();
+  }
   return d;
 }
 
-double PointCloud::search(Query& q, double best, double stop_below) {
+double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towards) {
   ++counters.queries;
   // a node's bound: the larger of the boxes' gap and the separation along the centres
   auto node_bound = [&](const Node& node) {
     ++counters.nodes;
-    const coal::AABB box(node.centre - node.half, node.centre + node.half);
-    const double gap = q.box->distance(box);
-    return std::max(gap, q.bound(node.centre, node.half)) - radius_;
+    return q.bound(node.centre, node.half, best + radius_) - radius_;
   };
   stack_.clear();
   if (node_bound(nodes_[0]) < best) stack_.push_back(0);
@@ -141,9 +166,22 @@ double PointCloud::search(Query& q, double best, double stop_below) {
     if (node.left < 0) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
         ++counters.points;
-        const double bound = q.bound(points_[i], Vec3s::Zero()) - radius_;
+        const double bound = q.bound(points_[i], Vec3s::Zero(), best + radius_) - radius_;
         if (bound >= best) continue;
-        best = std::min(best, q.ball ? std::max(bound, 0.0) : exact(q, i));
+        Vec3s dir;
+        double d;
+        if (q.ball) {  // the bound is the distance, along the centres' line
+          d = std::max(bound, 0.0);
+          dir = q.support.centre - points_[i];
+          const double length = dir.norm();
+          dir = length > 0.0 ? Vec3s(dir / length) : Vec3s(Vec3s::Zero());
+        } else {
+          d = exact(q, i, dir);
+        }
+        if (d < best) {
+          best = d;
+          if (towards != nullptr) *towards = dir;
+        }
         if (best < stop_below) return best;
       }
       continue;
@@ -162,12 +200,37 @@ bool PointCloud::collides(const coal::CollisionObject& shape) {
   Query q(shape);
   // a contact within GJK's tolerance counts (as collision_request() counts it)
   const double within = distance_request(false).gjk_tolerance;
-  return search(q, within, within) < within;
+  return search(q, within, within, nullptr) < within;
 }
 
-double PointCloud::distance(const coal::CollisionObject& shape, double cap) {
+double PointCloud::distance(const coal::CollisionObject& shape, double cap, Vec3s* towards) {
   Query q(shape);
-  return std::max(search(q, cap, std::numeric_limits<double>::min()), 0.0);
+  if (towards != nullptr) towards->setZero();
+  return std::max(search(q, cap, std::numeric_limits<double>::min(), towards), 0.0);
+}
+
+double PointCloud::support(const coal::AABB& region, const Vec3s& n) const {
+  // a ball meets the region only if its centre lies in the region grown by the radius
+  const coal::AABB grown(region.min_ - Vec3s::Constant(radius_),
+                         region.max_ + Vec3s::Constant(radius_));
+  const Vec3s m = n.cwiseAbs();
+  double best = -std::numeric_limits<double>::infinity();
+  std::vector<std::int32_t> stack{0};
+  while (!stack.empty()) {
+    const Node& node = nodes_[stack.back()];
+    stack.pop_back();
+    const coal::AABB box(node.centre - node.half, node.centre + node.half);
+    // nothing of the node in the region, or nothing of it above what is known
+    if (!grown.overlap(box) || n.dot(node.centre) + m.dot(node.half) <= best) continue;
+    if (node.left >= 0) {
+      stack.push_back(node.left);
+      stack.push_back(node.left + 1);
+      continue;
+    }
+    for (std::uint32_t i = node.begin; i < node.end; ++i)
+      if (grown.contain(points_[i])) best = std::max(best, n.dot(points_[i]));
+  }
+  return best + radius_ * n.norm();
 }
 
 }  // namespace kcplan

@@ -33,7 +33,9 @@ struct CloudCounters {
 /// ShapeSupport describes) is measured against a node by two lower bounds of the distance
 /// from S to any point of the node's box B, and the larger is used:
 ///
-///  - the gap between S's world bounding box and B (S lies in its box);
+///  - the gap between S's world bounding box and B (S lies in its box), and between S's
+///    box in its own frame (coal's aabb_local) and B's bounding ball (B about m lies
+///    within rho = |half| of m);
 ///  - S's separation along n = (m - c) / |m - c|, c S's centre and m B's centre:
 ///    every x of S has n . x <= n . c + spread_S(n) and every y of B has
 ///    n . y >= n . m - rho (rho B's half diagonal), so |y - x| >= n . (y - x) >=
@@ -76,8 +78,16 @@ class PointCloud {
   /// Whether some ball touches `shape` (at its transform, its AABB computed).
   bool collides(const coal::CollisionObject& shape);
   /// min(cap, the distance from `shape` to the nearest ball), 0 on contact; as coal
-  /// measures it (see the class notes). `cap` = inf for the distance itself.
-  double distance(const coal::CollisionObject& shape, double cap);
+  /// measures it (see the class notes). `cap` = inf for the distance itself. With
+  /// `towards`, the unit direction from that ball's nearest point towards the shape's
+  /// (zero when no ball is nearer than the cap, or on contact).
+  double distance(const coal::CollisionObject& shape, double cap,
+                  coal::Vec3s* towards = nullptr);
+  /// The support of the balls that meet `region` along `n`: the largest n . y over every
+  /// point y of those balls (-inf if none). Every ball meeting the region lies in
+  /// {x : n . x <= support}: a plane of the points near a body, for region certificates
+  /// (balls beyond the region are farther than it reaches).
+  double support(const coal::AABB& region, const coal::Vec3s& n) const;
 
   CloudCounters counters;
 
@@ -92,10 +102,11 @@ class PointCloud {
   /// Fill node `index` (already allocated) with points_[begin, end) and its subtree.
   void build(std::size_t index, std::uint32_t begin, std::uint32_t end, std::size_t leaf_size);
   /// GJK's distance from the query shape to the ball about point i (<= 0: contact).
-  double exact(Query& q, std::size_t i);
+  /// `towards` gets GJK's unit direction from the ball to the shape (zero if none).
+  double exact(Query& q, std::size_t i, coal::Vec3s& towards);
   /// min(best, the distance to the nearest ball), depth first, the nearer child first;
   /// returns as soon as a ball nearer than `stop_below` is found.
-  double search(Query& q, double best, double stop_below);
+  double search(Query& q, double best, double stop_below, coal::Vec3s* towards);
 
   std::vector<coal::Vec3s> points_;
   std::vector<Node> nodes_;

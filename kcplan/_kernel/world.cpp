@@ -662,9 +662,27 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
         continue;
       }
     }
-    // a cloud is measured up to the horizon only: past it, its plane says nothing more
-    const double d = pair_distance(body, k, *obstacle, request, result,
-                                   (horizon + atol_) / (1.0 - rtol_));
+    if (PointCloud* cloud = cloud_of(*obstacle)) {
+      // measured up to the horizon only; its plane holds the balls that meet the
+      // horizon's box (every other ball is farther than the horizon)
+      Vec3s towards;
+      const double d = cloud->distance(body, (horizon + atol_) / (1.0 - rtol_), &towards);
+      if (!(d > 0.0)) {
+        region.planes.clear(), region.horizon = 0.0;
+        return false;
+      }
+      Plane plane;
+      plane.clearance = std::max(d * keep - atol_, 0.0);
+      plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
+      plane.offset = std::numeric_limits<double>::infinity();
+      if (dimension_ == 3 && towards.squaredNorm() > 0.0) {
+        for (int i = 0; i < 3; ++i) plane.n[i] = towards[i];
+        plane.offset = cloud->support(box.getAABB(), towards);
+      }
+      region.planes.push_back(plane);
+      continue;
+    }
+    const double d = pair_distance(body, k, *obstacle, request, result);
     if (!(d > 0.0)) {
       region.planes.clear(), region.horizon = 0.0;
       return false;
