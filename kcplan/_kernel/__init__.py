@@ -132,6 +132,7 @@ def build_kernel_world(scenario, robot, half_height: float) -> _core.World:
     )
     atol = COAL_CLEARANCE_ATOL * size + COAL_CLEARANCE_FLOOR * (1.0 + ball)
     world = _core.World(kernel_robot(robot), float(half_height), COAL_CLEARANCE_RTOL, atol)
+    world.padding = float(getattr(scenario, "padding", 0.0))
     add_obstacles(world, scenario.obstacles, n)
     world.finalize()
     return world
@@ -202,6 +203,7 @@ def build_kernel_arm(world) -> _core.ArmWorld:
     atol = COAL_CLEARANCE_ATOL * world.size + COAL_CLEARANCE_FLOOR * (1.0 + ball)
     pairs = [(int(k), int(m)) for k, m in world.self_pairs]
     kernel = _core.ArmWorld(kernel_chain(world.arm), pairs, COAL_CLEARANCE_RTOL, atol)
+    kernel.scene.padding = float(world.padding)
     add_obstacles(kernel.scene, world.obstacles, 3)
     kernel.scene.finalize()
     return kernel

@@ -146,6 +146,8 @@ NB_MODULE(_core, m) {
              double radius) { w.add_points(points.data(), points.shape(0), radius); },
           "points"_a, "radius"_a)
       .def("finalize", &kcplan::World::finalize)
+      .def_prop_rw("padding", &kcplan::World::padding, &kcplan::World::set_padding,
+                   "Metres every body keeps from every obstacle (MoveIt's link padding)")
       .def_prop_ro("n_objects", &kcplan::World::n_objects)
       .def_prop_ro("dimension", [](const kcplan::World& w) { return w.robot().dimension(); })
       .def_prop_ro("atol", &kcplan::World::atol)

@@ -408,6 +408,12 @@ CloudCounters World::cloud_counters() const {
   return sum;
 }
 
+void World::set_padding(double padding) {
+  if (!(padding >= 0.0) || !std::isfinite(padding))
+    throw std::invalid_argument("padding: expected a finite number >= 0");
+  padding_ = padding;
+}
+
 void World::finalize() {
   if (finalized_) return;
   std::vector<coal::CollisionObject*> raw;
@@ -456,6 +462,12 @@ World::WarmStart& World::warm(std::size_t shape, const coal::CollisionObject& ob
 }
 
 bool World::collides(coal::CollisionObject& object, std::size_t shape) {
+  if (padding_ > 0.0) {  // nearer than the padding (beyond the allowance): a contact
+    const double cap = 2.0 * raw_cap(0.0);
+    DistanceNear near(this, &object, shape, cap);
+    manager_->distance(&object, &near);
+    return near.best < cap && !(clear(near.best) > 0.0);
+  }
   CollideNear near(this, &object, shape);
   manager_->collide(&object, &near);
   return near.hit;
@@ -535,7 +547,7 @@ void World::safe_body_clearances(const Pose& pose, double* out) {
 void World::bodies_safe_clearances(double* out, const double* caps) {
   if (caps == nullptr) {
     bodies_distances(out);
-    for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = safe(out[k]);
+    for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = clear(out[k]);
     return;
   }
   ++counters.distance_queries;
@@ -572,22 +584,21 @@ bool World::grown_body_clear(std::size_t k, const coal::Transform3s& frame, doub
   count_body(k);
   // clear when its distance is certainly positive: past the smallest cap that says so
   const double cap = std::numeric_limits<double>::min();
-  const double raw = (cap + atol_) / (1.0 - rtol_);
+  const double raw = raw_cap(cap);
   DistanceNear near(this, &grown, k, raw);  // body k's warm starts: a shape like it
   manager_->distance(&grown, &near);
-  return near.best >= raw || safe(near.best) > 0.0;
+  return near.best >= raw || clear(near.best) > 0.0;
 }
 
 double World::capped_clearance(std::size_t k, double cap) {
   if (objects_.empty()) return std::numeric_limits<double>::infinity();
   count_body(k);
   // a raw distance of at least (cap + atol) / (1 - rtol) is certainly at least cap
-  const double raw = cap < std::numeric_limits<double>::infinity()
-                         ? (cap + atol_) / (1.0 - rtol_)
-                         : std::numeric_limits<double>::infinity();
+  const double raw =
+      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap) : std::numeric_limits<double>::infinity();
   DistanceNear near(this, bodies_[k].get(), k, raw);
   manager_->distance(bodies_[k].get(), &near);
-  return near.best >= raw ? cap : safe(near.best);
+  return near.best >= raw ? cap : clear(near.best);
 }
 
 bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out) {
@@ -607,7 +618,7 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
     }
     if (region.planes.empty()) {  // open space: the clearance to everything is the better horizon
       ++counters.distance_queries;
-      region.horizon = std::max(horizon, distance(*bodies_[k], k) * (1.0 - rtol_) - atol_);
+      region.horizon = std::max(horizon, clear(distance(*bodies_[k], k)));
     }
   }
   return true;
@@ -644,7 +655,6 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
   counters.region_pairs += static_cast<std::int64_t>(near_.size());
   coal::DistanceRequest request = distance_request(/*nearest_points=*/true);
   coal::DistanceResult result;
-  const double keep = 1.0 - rtol_;
   ShapeSupport shape;
   primitive_slabs = primitive_slabs && ShapeSupport::of(body, shape);
   for (coal::CollisionObject* obstacle : near_) {
@@ -652,11 +662,11 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
     if (primitive_slabs && primitives_[index].kind != Primitive::kNone) {
       bool exact;
       Vec3s n;
-      const double gap = primitives_[index].separation(shape, exact, n);
-      if (gap > 0.0) {  // the obstacle lies in {n . x <= support(n)}, the body beyond it
+      const double gap = primitives_[index].separation(shape, exact, n) - padding_;
+      if (gap > 0.0) {  // the (padded) obstacle lies in {n . x <= support(n) + padding}
         Plane plane;
         for (int i = 0; i < 3; ++i) plane.n[i] = n[i];
-        plane.offset = primitives_[index].support(n);
+        plane.offset = primitives_[index].support(n) + padding_;
         plane.clearance = gap;
         region.planes.push_back(plane);
         continue;
@@ -666,29 +676,30 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
       // measured up to the horizon only; its plane holds the balls that meet the
       // horizon's box (every other ball is farther than the horizon)
       Vec3s towards;
-      const double d = cloud->distance(body, (horizon + atol_) / (1.0 - rtol_), &towards);
-      if (!(d > 0.0)) {
+      const double d = cloud->distance(body, raw_cap(horizon), &towards);
+      if (!(d > 0.0) || (padding_ > 0.0 && !(clear(d) > 0.0))) {
         region.planes.clear(), region.horizon = 0.0;
         return false;
       }
       Plane plane;
-      plane.clearance = std::max(d * keep - atol_, 0.0);
+      plane.clearance = clear(d);
       plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
       plane.offset = std::numeric_limits<double>::infinity();
       if (dimension_ == 3 && towards.squaredNorm() > 0.0) {
         for (int i = 0; i < 3; ++i) plane.n[i] = towards[i];
-        plane.offset = cloud->support(box.getAABB(), towards);
+        // the padded balls lie in {n . x <= support + padding}
+        plane.offset = cloud->support(box.getAABB(), towards) + padding_;
       }
       region.planes.push_back(plane);
       continue;
     }
     const double d = pair_distance(body, k, *obstacle, request, result);
-    if (!(d > 0.0)) {
+    if (!(d > 0.0) || (padding_ > 0.0 && !(clear(d) > 0.0))) {
       region.planes.clear(), region.horizon = 0.0;
       return false;
     }
     Plane plane;
-    plane.clearance = std::max(d * keep - atol_, 0.0);
+    plane.clearance = clear(d);
     const Support& support = supports_[index];
     double v[3] = {0.0, 0.0, 0.0};
     if (support.kind != Support::kNone) {  // a mesh's distance may come without points
@@ -701,7 +712,8 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
       plane.offset = std::numeric_limits<double>::infinity();
     } else {
       for (int i = 0; i < 3; ++i) plane.n[i] = v[i] / length;
-      plane.offset = support(plane.n);  // exact: a wrong direction only weakens the plane
+      // exact: a wrong direction only weakens the plane; the padding lies beyond it
+      plane.offset = support(plane.n) + padding_;
     }
     region.planes.push_back(plane);
   }
@@ -750,12 +762,11 @@ double World::ball_safe_clearance(const std::array<double, 3>& centre, double ra
   coal::CollisionObject& ball = place_ball(centre, radius);
   // as capped_clearance: a raw distance of at least (cap + atol) / (1 - rtol) is certainly
   // at least cap
-  const double raw = cap < std::numeric_limits<double>::infinity()
-                         ? (cap + atol_) / (1.0 - rtol_)
-                         : std::numeric_limits<double>::infinity();
+  const double raw =
+      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap) : std::numeric_limits<double>::infinity();
   DistanceNear near(this, &ball, core_shape(), raw);
   manager_->distance(&ball, &near);
-  return near.best >= raw ? cap : safe(near.best);
+  return near.best >= raw ? cap : clear(near.best);
 }
 
 bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,

@@ -161,6 +161,19 @@ class World {
   /// A distance reduced by the error allowance, d (1 - rtol) - atol, at least 0: what a
   /// coal distance certainly is (never an overestimate).
   double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
+  /// What an obstacle's coal distance certainly leaves beyond the padding: safe(d) less
+  /// the padding, at least 0. Every clearance of a body to the obstacles is this.
+  double clear(double d) const {
+    return std::max(d * (1.0 - rtol_) - atol_ - padding_, 0.0);
+  }
+  /// The raw coal distance past which a body is certainly clear by `cap` beyond the
+  /// padding: clear(d) >= cap for every d at least this.
+  double raw_cap(double cap) const { return (cap + atol_ + padding_) / (1.0 - rtol_); }
+  /// Keep every body at least `padding` (>= 0, finite; length units) from every obstacle:
+  /// clearances are reduced by it and a body nearer than it is in collision (MoveIt's
+  /// link padding; self pairs are not padded). 0 by default.
+  void set_padding(double padding);
+  double padding() const { return padding_; }
 
   /// Whether body k grown about its centre by `scale` (its semi-axes times scale >= 1)
   /// and placed at `frame` is certainly clear of every obstacle: its clearance, reduced by
@@ -269,6 +282,7 @@ class World {
   Robot robot_;
   int dimension_;
   double half_height_, rtol_, atol_;
+  double padding_ = 0.0;
   std::vector<std::unique_ptr<coal::CollisionObject>> objects_;
   std::vector<Support> supports_;
   std::vector<Primitive> primitives_;  // per obstacle; kNone: not a box, ball or cylinder

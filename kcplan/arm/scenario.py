@@ -58,6 +58,7 @@ from kcplan.world.scenario import (
     Obstacle,
     ScenarioError,
     parse_obstacle,
+    read_padding,
     self_filtered,
 )
 
@@ -83,6 +84,10 @@ class ArmScenario:
     description: str = ""
     source: str = "<string>"
     directory: Path = field(default_factory=Path.cwd)
+    padding: float = 0.0
+    """The clearance (metres) every certified path keeps from every obstacle and point
+    (``robot.padding``; MoveIt's link padding, attached parts included; self pairs are not
+    padded)."""
     dimension = 3
 
     @property
@@ -139,7 +144,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     spec = r.mapping(
         top["robot"], "robot", (),
         ("urdf", "example", "joints", "srdf", "fixed", "package_dirs", "representation",
-         "bodies_per_link", "max_offset", "inflation"),
+         "bodies_per_link", "max_offset", "inflation", "padding"),
     )  # fmt: skip
     if ("urdf" in spec) == ("example" in spec):
         r.fail("robot", "a urdf (a file) or an example (a robot of example-robot-data)",
@@ -224,7 +229,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     allowed = _allowed(r, top.get("allowed") or [])
     return ArmScenario(
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
-        description, source, directory,
+        description, source, directory, read_padding(r, spec),
     )  # fmt: skip
 
 

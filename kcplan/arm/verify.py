@@ -140,6 +140,11 @@ class ArmMeshChecker:
         collision matrix), beside the SRDF's disabled pairs.
     tolerance : float
         A distance at or below this (metres) is a collision.
+    padding : float
+        Metres each link must keep from the obstacles (not from other links): a link
+        nearer than ``padding + tolerance`` to the scene is a collision (``kcplan verify
+        --padding``); the advancement then steps by the distance less the padding, so
+        the padding is checked without gaps too.
 
     Notes
     -----
@@ -158,9 +163,10 @@ class ArmMeshChecker:
         obstacles: Sequence[Obstacle],
         allowed: Collection[frozenset] = (),
         tolerance: float = 1e-6,
+        padding: float = 0.0,
     ) -> None:
         geometry = arm.geometry
-        self.arm, self.tolerance = arm, float(tolerance)
+        self.arm, self.tolerance, self.padding = arm, float(tolerance), float(padding)
         self._links, self._hulls, reaches, joints = [], [], [], []
         for obj in geometry.geometryObjects:
             shape, reach = _link_geometry(obj)
@@ -311,6 +317,8 @@ class ArmMeshChecker:
                     d = self._distance(int(item))
                     queries += 1
                     lowest = min(lowest, d)
+                    if item < len(self._links):  # the scene grown by the padding
+                        d -= self.padding
                     if d <= self.tolerance:
                         return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries,
                                             self._what(int(item)),
@@ -337,9 +345,11 @@ def verify_arm_path(
     tolerance: float = 1e-6,
     max_queries: int = 1_000_000,
     allowed: Collection[frozenset] = (),
+    padding: float = 0.0,
 ) -> ArmPathCheck:
     """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints` order)
     without gaps against ``obstacles`` and self-collision (the pairs of
     :attr:`ArmModel.geometry` whose links are not an ``allowed`` pair); see the module
-    docstring. To check many paths in one scene, build an :class:`ArmMeshChecker` once."""
-    return ArmMeshChecker(arm, obstacles, allowed, tolerance).check(states, max_queries)
+    docstring. To check many paths in one scene, build an :class:`ArmMeshChecker` once.
+    ``padding``: metres every link must keep from the obstacles (:class:`ArmMeshChecker`)."""
+    return ArmMeshChecker(arm, obstacles, allowed, tolerance, padding).check(states, max_queries)

@@ -76,6 +76,9 @@ class ArmWorld:
     prove_pairs : bool, optional
         Leave out the self pairs proven apart over the whole joint box
         (:mod:`kcplan.arm.pairs`, once per arm); False checks them all (the ablation).
+    padding : float, optional
+        Metres every body keeps from every obstacle in the compiled :attr:`kernel`'s
+        queries (MoveIt's link padding; self pairs are not padded).
 
     Notes
     -----
@@ -91,9 +94,15 @@ class ArmWorld:
         size: float | None = None,
         allowed: Collection[frozenset] = (),
         prove_pairs: bool = True,
+        padding: float = 0.0,
     ):
         self.arm = arm
         self.obstacles = tuple(obstacles)
+        if not (padding >= 0.0 and math.isfinite(padding)):
+            raise ValueError(f"padding: expected a finite number >= 0, got {padding!r}")
+        self.padding = float(padding)
+        """Metres every body keeps from every obstacle, kept by :attr:`kernel`'s queries
+        (the python-fcl queries of this class do not pad)."""
         self.allowed = frozenset(allowed)
         pairs = checked_pairs(arm, self.allowed)
         self.proven_apart = 0

@@ -10,6 +10,7 @@ from kcplan.cli.common import (
     InputError,
     duration,
     load_input,
+    non_negative_float,
     output_file,
     planner_name,
     positive_float,
@@ -63,16 +64,24 @@ def run(args: argparse.Namespace) -> int:
         if reason:
             raise InputError(f"{args.scenario}: --meshes visual: {reason}")
     from kcplan.planning.names import check_planner_for
-    from kcplan.planning.problem import plan
+    from kcplan.planning.problem import PLANNERS, plan
 
     try:  # an arm-only planner on a rigid robot, the paper's on several bodies: one line, exit 2
         check_planner_for(args.planner, scenario)
     except ValueError as err:
         raise InputError(f"{args.scenario}: --planner: {err}") from None
     velocity, acceleration = limits if limits is not None else (None, None)
-    result = plan(scenario, args.planner, args.time, args.seed, args.simplify,
-                  trajectory=limits is not None, velocity_limits=velocity,
-                  acceleration_limits=acceleration)  # fmt: skip
+    if args.padding is not None and args.padding > 0 and not PLANNERS[args.planner].kc:
+        raise InputError(f"{args.scenario}: --padding: kept by the kc-* and ca-* planners "
+                         f"only (edges certified); {args.planner} checks samples")  # fmt: skip
+    try:
+        result = plan(scenario, args.planner, args.time, args.seed, args.simplify,
+                      trajectory=limits is not None, velocity_limits=velocity,
+                      acceleration_limits=acceleration, padding=args.padding)  # fmt: skip
+    except ValueError as err:
+        if not str(err).startswith("padding:"):
+            raise
+        raise InputError(f"{args.scenario}: --{err}") from None
     status = "solved" if result.solved else "NOT solved"
     print(
         f"{scenario.name}: {status} by {args.planner} in {duration(result.time)} "
@@ -246,6 +255,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="planning time limit (default 10)",
     )
     p.add_argument("--seed", type=int, help="OMPL random seed, for reproducible runs")
+    p.add_argument(
+        "--padding",
+        type=non_negative_float,
+        metavar="P",
+        help="clearance every certified edge keeps from every obstacle and point, in the "
+        "scenario's unit (default: the scenario's robot.padding, else 0)",
+    )
     p.add_argument(
         "--simplify",
         action=argparse.BooleanOptionalAction,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kcplan.cli.common import InputError, load_input, positive_float
+from kcplan.cli.common import InputError, load_input, non_negative_float, positive_float
 
 
 def _read_json(path: str) -> dict:
@@ -72,12 +72,13 @@ def run(args: argparse.Namespace) -> int:
     part = ""  # names the part in the report when --mesh checks it
     if args.mesh is not None:
         world, part = _part_world(args, scenario, world)
-    check = verify_path(world, states, tolerance=args.tolerance)
+    check = verify_path(world, states, tolerance=args.tolerance, padding=_padding(args, scenario))
     edges = max(len(states) - 1, 1)
     if check.collides:
         pose = ", ".join(f"{v:.6g}" for v in check.first_collision)
         print(
-            f"COLLISION{f' of {part}' if part else ''} on edge {check.edge_index} at "
+            f"{_closer(args, scenario)}{f' of {part}' if part else ''} on edge "
+            f"{check.edge_index} at "
             f"s = {check.s:.6f}: pose "
             f"[{pose}] ({check.queries} clearance queries)"
         )
@@ -98,17 +99,30 @@ def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
         raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
     _within_limits(args.path, "states", scenario.arm, states)
     check = verify_arm_path(
-        scenario.arm, scenario.obstacles, states, args.tolerance, allowed=scenario.allowed
-    )
+        scenario.arm, scenario.obstacles, states, args.tolerance, allowed=scenario.allowed,
+        padding=_padding(args, scenario),
+    )  # fmt: skip
     if check.collides:
         edge, s = check.where
-        print(f"COLLISION of the links' meshes on edge {edge} at s = {s:.6f} "
+        print(f"{_closer(args, scenario)} of the links' meshes on edge {edge} at s = {s:.6f} "
               f"({check.queries} distance queries)")  # fmt: skip
         return 1
     edges = max(len(states) - 1, 1)
     print(f"clean: the links' meshes, {edges} edges checked without gaps, minimum "
           f"clearance {check.min_clearance:.6g}, {check.queries} distance queries")  # fmt: skip
     return 0
+
+
+def _padding(args: argparse.Namespace, scenario) -> float:
+    """``--padding``, else the scenario's ``robot.padding``."""
+    return scenario.padding if args.padding is None else args.padding
+
+
+def _closer(args: argparse.Namespace, scenario) -> str:
+    """How a verdict names a pose nearer than the tolerance: a collision, or nearer than
+    the padding when there is one."""
+    padding = _padding(args, scenario)
+    return f"CLOSER THAN THE PADDING {padding:g}" if padding > 0 else "COLLISION"
 
 
 LIMIT_TOLERANCE = 1e-6
@@ -139,12 +153,15 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
     _within_limits(args.path, "curve.waypoints", arm, file.path.waypoints)
     off = file.deviations()
     problems = _sample_problems(off)
-    checker = ArmMeshChecker(arm, scenario.obstacles, scenario.allowed, args.tolerance)
+    checker = ArmMeshChecker(
+        arm, scenario.obstacles, scenario.allowed, args.tolerance, _padding(args, scenario)
+    )
     check = checker.check_pieces(file.path.pieces())
     pieces = len(file.path.breakpoints) - 1
     if check.collides:
         piece, s = check.where
-        problems.append(f"COLLISION of the links' meshes ({check.what}) on piece {piece} of "
+        problems.append(f"{_closer(args, scenario)} of the links' meshes ({check.what}) on "
+                        f"piece {piece} of "
                         f"the curve at {s:.6f} of it")  # fmt: skip
     checked = (f"the links' meshes along the whole curve ({pieces} pieces, "
                f"{int((file.path.blends > 0).sum())} blends)")  # fmt: skip
@@ -194,9 +211,12 @@ def _verify_rigid_trajectory(args: argparse.Namespace, scenario, data: dict) -> 
         world, part = _part_world(args, scenario, world)
     off = file.deviations()
     problems = _sample_problems(off)
-    check = verify_path(world, file.waypoints, tolerance=args.tolerance)
+    check = verify_path(
+        world, file.waypoints, tolerance=args.tolerance, padding=_padding(args, scenario)
+    )
     if check.collides:
-        problems.append(f"COLLISION{f' of {part}' if part else ''} on edge {check.edge_index} "
+        problems.append(f"{_closer(args, scenario)}{f' of {part}' if part else ''} on edge "
+                        f"{check.edge_index} "
                         f"at s = {check.s:.6f}")  # fmt: skip
     checked = f"{f'{part}, ' if part else ''}{len(file.waypoints) - 1} edges"
     return _report(problems, checked, check, "clearance", len(file.t), off)
@@ -261,6 +281,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=positive_float,
         default=1e-6,
         help="clearance below which a pose counts as colliding (default 1e-6)",
+    )
+    p.add_argument(
+        "--padding",
+        type=non_negative_float,
+        metavar="P",
+        help="clearance the path must keep from the obstacles, checked without gaps "
+        "(default: the scenario's robot.padding, else 0)",
     )
     p.add_argument(
         "--mesh",

@@ -342,10 +342,11 @@ class PlanResult:
     a rigid robot's :class:`~kcplan.planning.trajectory.RigidTimedPath`; not written to
     JSON (its own file: their ``document()``)."""
 
-    def verify(self, tolerance: float = 1e-6) -> PathCheck:
+    def verify(self, tolerance: float = 1e-6, padding: float | None = None) -> PathCheck:
         """Check the path without gaps, independently of every certificate
         (:func:`kcplan.planning.verify.verify_path`: FCL clearances and conservative
-        advancement). ``tolerance`` is in the scenario's length unit.
+        advancement). ``tolerance`` is in the scenario's length unit; ``padding`` (default:
+        the scenario's) is the clearance the path must keep from the obstacles.
 
         Raises
         ------
@@ -354,10 +355,12 @@ class PlanResult:
         """
         if not self.solved or self.problem is None:
             raise ValueError(f"verify: expected a solved plan, got {self.planner} not solved")
-        if isinstance(self.problem, ArmScenario):
-            p = self.problem
-            return verify_arm_path(p.arm, p.obstacles, self.states, tolerance, allowed=p.allowed)
-        return verify_path(CollisionWorld(self.problem), self.states, tolerance)
+        p = self.problem
+        padding = p.padding if padding is None else float(padding)
+        if isinstance(p, ArmScenario):
+            return verify_arm_path(p.arm, p.obstacles, self.states, tolerance,
+                                   allowed=p.allowed, padding=padding)  # fmt: skip
+        return verify_path(CollisionWorld(p), self.states, tolerance, padding=padding)
 
     def to_json(self) -> dict:
         """The ``PATH.json`` document of ``kcplan plan`` (an arm's has ``joints``)."""
@@ -394,6 +397,7 @@ def plan(
     trajectory: bool = False,
     velocity_limits=None,
     acceleration_limits=None,
+    padding: float | None = None,
 ) -> PlanResult:
     """Plan a path for the scenario's robot from start to goal.
 
@@ -435,6 +439,11 @@ def plan(
     velocity_limits, acceleration_limits : optional
         The trajectory's limits (:func:`kcplan.planning.trajectory.joint_limits`, or
         :func:`~kcplan.planning.trajectory.rigid_limits`).
+    padding : float, optional
+        The clearance every certified edge keeps from every obstacle and point, in the
+        scenario's unit (default: the scenario's ``robot.padding``, else 0): the compiled
+        kernel's queries count a body nearer than it as a collision and take it off
+        every clearance (MoveIt's link padding; an arm's self pairs are not padded).
 
     Returns
     -------
@@ -451,6 +460,10 @@ def plan(
     except ValueError as err:
         raise ValueError(f"planner: {err}") from None
     scenario = as_scenario(scenario)
+    if padding is not None:
+        if not (padding >= 0 and math.isfinite(padding)):
+            raise ValueError(f"padding: expected a finite number >= 0, got {padding!r}")
+        scenario = replace(scenario, padding=float(padding))
     arm = isinstance(scenario, ArmScenario)
     planner = planner or default_planner(arm)
     try:  # the arm-only planners refuse a rigid robot, the paper's any robot but E_a

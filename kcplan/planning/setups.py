@@ -116,6 +116,15 @@ class ProblemSetup:
         self.si = self.ss.getSpaceInformation()
 
 
+def _require_kernel_for_padding(scenario, spec: PlannerSpec) -> None:
+    """The padding is kept by the compiled kernel's queries alone (World::set_padding)."""
+    if scenario.padding > 0 and spec.backend != "kernel":
+        raise ValueError(
+            f"padding: kept by the compiled kernel only; {spec.backend} planners ignore it "
+            "(use a kernel planner, or no padding)"
+        )
+
+
 class RigidSetup(ProblemSetup):
     """SE(2) or SE(3) within the scenario's bounds; states checked by the kernel's (or
     python-fcl's) collision query; the validator's certificates those of the planner."""
@@ -124,6 +133,7 @@ class RigidSetup(ProblemSetup):
 
     def __init__(self, scenario: Scenario, spec: PlannerSpec, world: CollisionWorld | None):
         self.n = n = scenario.dimension
+        _require_kernel_for_padding(scenario, spec)
         self.world = world or CollisionWorld(scenario)
         self.robot = self.world.robot
         self.screen_step = RIGID_SCREEN_STEP * self.robot.smallest_semi_axis
@@ -180,7 +190,10 @@ class ArmSetup(ProblemSetup):
 
     def __init__(self, scenario: ArmScenario, spec: PlannerSpec, world: ArmWorld | None):
         arm = self.robot = self.arm = scenario.arm
-        self.world = world or ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
+        _require_kernel_for_padding(scenario, spec)
+        self.world = world or ArmWorld(
+            arm, scenario.obstacles, allowed=scenario.allowed, padding=scenario.padding
+        )
         self.world.reset_counters()
         self.backend, self.joints = spec.backend, arm.joints
         self._open(joint_space(arm.lower, arm.upper))

@@ -52,6 +52,7 @@ def verify_path(
     states: ArrayLike,
     tolerance: float = 1e-6,
     max_queries: int = 10**6,
+    padding: float = 0.0,
 ) -> PathCheck:
     """Check every edge of a path, interpolated as OMPL does, without gaps.
 
@@ -66,6 +67,11 @@ def verify_path(
         length units; this also bounds the number of steps near contact.
     max_queries : int
         Safety limit; exceeding it is reported as a collision (not proven free).
+    padding : float
+        The clearance the path must keep (length units): a pose nearer than ``padding +
+        tolerance`` counts as a collision, and each step advances by the clearance less
+        the padding, so the padding is checked without gaps (``min_clearance`` stays the
+        clearance itself).
     """
     P = np.asarray(states, dtype=float)
     n = world.dimension
@@ -85,6 +91,7 @@ def verify_path(
             d = world.safe_clearance(pose)
             queries += 1
             lowest = min(lowest, d)
+            d -= padding  # the obstacles grown by the padding
             if d < tolerance or queries > max_queries:
                 return PathCheck(
                     True, 0.0 if d < tolerance else lowest, queries, k, s, pose.tolist()

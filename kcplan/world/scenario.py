@@ -71,6 +71,7 @@ __all__ = [
     "parse_obstacle",
     "self_filtered",
     "parse_rigid_scenario",
+    "read_padding",
     "read_scenario_data",
     "scenario_to_dict",
     "write_scenario_yaml",
@@ -182,6 +183,9 @@ class Scenario:
     part: Solid | None = None
     """The robot's own part (:class:`kcplan.cover.Solid`) when the robot is the cover of
     a mesh (``robot: {mesh: ...}``), else None; ``kcplan verify --mesh`` checks it."""
+    padding: float = 0.0
+    """The clearance every certified path keeps from every obstacle and point, in the
+    scenario's unit (``robot.padding``; MoveIt's link padding)."""
 
     @property
     def semi_axes(self) -> NDArray[np.float64]:
@@ -374,7 +378,7 @@ def _robot(r: FieldReader, value: Any, n: int, directory: Path) -> tuple[Robot, 
     ``bodies``, or a ``mesh`` to cover), its guard inflation and the mesh's part (or
     None)."""
     spec = r.mapping(value, "robot", (), ("semi_axes", "bodies", "mesh", "scale", "hull",
-                                          "inflation"))  # fmt: skip
+                                          "inflation", "padding"))  # fmt: skip
     inflation = r.number(spec.get("inflation", DEFAULT_INFLATION), "robot.inflation", True)
     if "mesh" in spec:
         if "semi_axes" in spec:
@@ -682,6 +686,7 @@ def parse_rigid_scenario(
     if not (low < high).all():
         r.fail("bounds", "low < high in every coordinate", top["bounds"])
     robot, inflation, part = _robot(r, top["robot"], n, directory)
+    padding = read_padding(r, top["robot"])
     poses = {}
     for key in ("start", "goal"):
         pose = r.pose(top[key], key, n)
@@ -718,8 +723,18 @@ def parse_rigid_scenario(
         source,
         directory,
         part,
+        padding,
     )
     return scenario
+
+
+def read_padding(r: FieldReader, robot: Any) -> float:
+    """``robot.padding``: a number >= 0 (default 0), the clearance kept from obstacles."""
+    value = robot.get("padding", 0.0) if isinstance(robot, dict) else 0.0
+    padding = r.number(value, "robot.padding")
+    if padding < 0:
+        r.fail("robot.padding", "a clearance of at least 0", value)
+    return padding
 
 
 def _bodies_mask(robot: Robot, pose: NDArray, points: NDArray, padding: float) -> NDArray:
@@ -850,7 +865,9 @@ def scenario_to_dict(scenario: Scenario) -> dict:
     out |= {
         "dimension": n,
         "bounds": {"low": scenario.bounds[0].tolist(), "high": scenario.bounds[1].tolist()},
-        "robot": scenario.robot.to_spec() | {"inflation": scenario.inflation},
+        "robot": scenario.robot.to_spec()
+        | {"inflation": scenario.inflation}
+        | ({"padding": scenario.padding} if scenario.padding else {}),
         "start": pose(scenario.start),
         "goal": pose(scenario.goal),
         "obstacles": [{o.kind: o.spec} for o in scenario.obstacles],
