@@ -135,3 +135,32 @@ def test_bad_clouds_are_refused_with_a_message():
     planar = KernelWorld(KernelRobot(2, [0.1, 0.1], [0, 0, 0]), 1.0, 0, 0)
     with pytest.raises(ValueError, match="3D"):
         planar.add_points(np.zeros((2, 3)), 0.01)
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(clouds(), st.floats(0.05, 1.0), st.floats(0.0, 0.3))
+def test_a_clouds_region_plane_holds_every_ball_near_the_body(case, horizon, padding):
+    """The plane of a cloud (free_regions): every ball (grown by the padding) within the
+    horizon of the body lies in {n . x <= offset} (the certificates use the plane only
+    where the body lies beyond it), and the plane's clearance is no more than the body's
+    distance to the balls less the padding."""
+    points, radius, axes, pose = case
+    world = _world(points, radius, axes)
+    world.padding = padding
+    free, regions = world.free_regions(pose, horizon)
+    brute = _coal_distances(points, radius, axes, pose)
+    if not free:  # a contact, within the padding
+        assert brute.min() * (1.0 - COAL_CLEARANCE_RTOL) <= padding + 1e-9
+        return
+    ((planes, region_horizon),) = regions
+    reach = horizon + max(axes)  # a ball nearer than the horizon has its centre in here
+    near = np.abs(points - pose[:3]).max(axis=1) <= reach + radius
+    for nx, ny, nz, offset, clearance in planes:
+        assert clearance <= max(brute.min() - padding, 0.0) + 1e-9
+        if not np.isfinite(offset):
+            continue
+        n = np.array([nx, ny, nz])
+        assert abs(np.linalg.norm(n) - 1.0) < 1e-9
+        assert (points[near] @ n + radius + padding <= offset + 1e-9).all()
+    if not planes:  # nothing within the horizon: the horizon is certain
+        assert region_horizon <= max(brute.min() - padding, 0.0) + 1e-9 or brute.min() >= horizon
