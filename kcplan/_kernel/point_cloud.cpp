@@ -1,6 +1,7 @@
 #include "point_cloud.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -14,6 +15,34 @@
 namespace kcplan {
 
 using coal::Vec3s;
+
+namespace {
+
+/// Unit directions of the faces, edges and corners of a cube: a hull's supports along
+/// them bound it by 26 planes (a k-DOP), which a point's local coordinates meet in 26
+/// dot products.
+std::array<Vec3s, 26> dop_directions() {
+  std::array<Vec3s, 26> out;
+  std::size_t k = 0;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x != 0 || y != 0 || z != 0) out[k++] = Vec3s(x, y, z).normalized();
+  return out;
+}
+
+const std::array<Vec3s, 26> kDopDirections = dop_directions();
+
+}  // namespace
+
+const PointCloud::Dop& PointCloud::dop_of(const coal::CollisionGeometry& hull,
+                                          const VertexSupport& support) {
+  auto [at, fresh] = dops_.try_emplace(&hull);
+  if (fresh)
+    for (std::size_t j = 0; j < kDopDirections.size(); ++j)
+      at->second[j] = support(kDopDirections[j]) * (1.0 + 1e-12) + 1e-15;
+  return at->second;
+}
 
 /// One query's shape and what the bounds need of it: its support, found once, and the
 /// planes {x : n . x <= h} holding it that GJK's nearest points have shown so far.
@@ -32,9 +61,11 @@ struct PointCloud::Query {
 
   coal::Matrix3s rotation;  // the shape's frame and its box there (coal's aabb_local)
   Vec3s origin, low, high;
+  const Dop* dop = nullptr;  // a hull's supports along kDopDirections (its frame), or null
 
-  explicit Query(const coal::CollisionObject& o)
+  Query(const coal::CollisionObject& o, PointCloud& cloud)
       : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)) {
+    if (support.hull_support != nullptr) dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
     rotation = o.getTransform().getRotation();
     origin = o.getTransform().getTranslation();
     low = o.collisionGeometryPtr()->aabb_local.min_;
@@ -56,8 +87,8 @@ struct PointCloud::Query {
   /// A lower bound of the distance from the shape to any point of the box about `m` of
   /// half sides `half` (a point: half = 0), less rounding, or a number at least `best`
   /// as soon as one is known (the cheap bounds first: the boxes' gap, the gap to the
-  /// shape's box in its own frame, its bounding ball, the kept planes, and only then the
-  /// support along the centres' line).
+  /// shape's box in its own frame, a hull's 26 fixed planes, its bounding ball, the kept
+  /// planes, and only then the support along the centres' line).
   double bound(const Vec3s& m, const Vec3s& half, double best) const {
     const double rho = half.norm();
     const double slack = 1e-12 * (scale + m.norm() + rho);
@@ -70,6 +101,13 @@ struct PointCloud::Query {
     const Vec3s local = rotation.transpose() * (m - origin);
     lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
     if (lower - slack >= best || !supported) return lower - slack;
+    if (dop != nullptr) {  // the hull lies in {x : d . x <= h_d} for each fixed direction d
+      double most = -std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < kDopDirections.size(); ++j)
+        most = std::max(most, kDopDirections[j].dot(local) - (*dop)[j]);
+      lower = std::max(lower, most - rho);
+      if (lower - slack >= best) return lower - slack;
+    }
     const Vec3s d = m - support.centre;
     const double length = d.norm();
     lower = std::max(lower, length - support.spread_high - rho);  // the shape's ball
@@ -197,14 +235,14 @@ double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towar
 }
 
 bool PointCloud::collides(const coal::CollisionObject& shape) {
-  Query q(shape);
+  Query q(shape, *this);
   // a contact within GJK's tolerance counts (as collision_request() counts it)
   const double within = distance_request(false).gjk_tolerance;
   return search(q, within, within, nullptr) < within;
 }
 
 double PointCloud::distance(const coal::CollisionObject& shape, double cap, Vec3s* towards) {
-  Query q(shape);
+  Query q(shape, *this);
   if (towards != nullptr) towards->setZero();
   return std::max(search(q, cap, std::numeric_limits<double>::min(), towards), 0.0);
 }

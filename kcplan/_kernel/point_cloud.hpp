@@ -5,7 +5,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <array>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <coal/BV/AABB.h>
@@ -41,6 +43,9 @@ struct CloudCounters {
 ///    n . y >= n . m - rho (rho B's half diagonal), so |y - x| >= n . (y - x) >=
 ///    |m - c| - spread_S(n) - rho.
 ///
+///  - for a convex polytope (a link's hull), the 26 planes across the faces, edges and
+///    corners of its frame's cube that touch it (its support there, found once per hull):
+///    the largest d . (m - c) - h(d) - rho, in the hull's frame;
 ///  - the planes {x : n . x <= h_S(n)} that hold S, one for each direction GJK's nearest
 ///    points have given so far in this query (a point of the cloud measured exactly):
 ///    every y of B has n . y >= n . m - |n| . half, so |y - x| >= n . m - |n| . half -
@@ -98,6 +103,10 @@ class PointCloud {
     std::int32_t left = -1;     // children (right = left + 1); -1: a leaf
   };
   struct Query;
+  /// A hull's supports along 26 fixed directions of its frame (conservatively rounded up).
+  using Dop = std::array<double, 26>;
+  /// The Dop of a link's hull (an immutable SupportedConvex), made on its first query.
+  const Dop& dop_of(const coal::CollisionGeometry& hull, const VertexSupport& support);
 
   /// Fill node `index` (already allocated) with points_[begin, end) and its subtree.
   void build(std::size_t index, std::uint32_t begin, std::uint32_t end, std::size_t leaf_size);
@@ -114,6 +123,7 @@ class PointCloud {
   coal::AABB bounds_;
   std::shared_ptr<coal::Sphere> ball_;
   std::vector<std::int32_t> stack_;
+  std::unordered_map<const coal::CollisionGeometry*, Dop> dops_;
 };
 
 }  // namespace kcplan
