@@ -165,3 +165,63 @@ def test_a_clouds_region_plane_holds_every_ball_near_the_body(case, horizon, pad
     if not planes:  # nothing within the horizon: the horizon is certain
         gjk = brute.min() * (1 + 1e-6) + 2e-6
         assert region_horizon <= max(gjk - padding, 0.0) or brute.min() >= horizon
+
+
+@pytest.fixture(scope="module")
+def panda():
+    """The bundled Panda, each link its own convex hull."""
+    from kcplan.scenarios import load_scenario
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    return load_scenario(root / "scenarios/arm/box_1.yaml").arm
+
+
+def _hull_distances(vertices, triangles, points) -> np.ndarray:
+    """Exact distances from points (m, 3) to a closed convex polytope (0 inside), free of
+    coal and FCL: the nearest point of each triangle (trimesh), and the facet planes
+    for inside."""
+    import trimesh
+
+    corners = vertices[triangles]  # (t, 3, 3)
+    m, t = len(points), len(triangles)
+    nearest = trimesh.triangles.closest_point(
+        np.repeat(corners, m, axis=0), np.tile(points, (t, 1))
+    ).reshape(t, m, 3)
+    outside = np.linalg.norm(nearest - points[None], axis=2).min(axis=0)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    centre = vertices.mean(axis=0)
+    flip = np.einsum("ij,ij->i", normals, corners[:, 0] - centre) < 0
+    normals[flip] *= -1
+    inside = (np.einsum("ij,mj->mi", normals, points) <=
+              np.einsum("ij,ij->i", normals, corners[:, 0])[None] + 1e-12).all(axis=1)  # fmt: skip
+    return np.where(inside, 0.0, outside)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1), st.floats(1e-3, 0.02))
+def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
+    """Each link hull's clearance to a cloud (the kernel's tree, its 26 planes, GJK's
+    planes) against the exact distance from the hull to every point, less the radius."""
+    from kcplan.arm.kinematics import body_frames
+    from kcplan.arm.world import ArmWorld
+    from kcplan.world.scenario import Obstacle
+
+    arm = panda
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(arm.lower, arm.upper)
+    frames = body_frames(arm, q)
+    # points around the links: near each link's centre, some within centimetres
+    centres = frames[:, :3, 3]
+    points = centres[rng.integers(len(centres), size=150)] + rng.normal(scale=0.08, size=(150, 3))
+    cloud = Obstacle(kind="pointcloud", index=0, spec={}, center=np.zeros(3), rotation=np.eye(3),
+                     extents=np.full(3, radius), vertices=np.ascontiguousarray(points))  # fmt: skip
+    kernel = ArmWorld(arm, [cloud], prove_pairs=False).kernel
+    scene, _ = kernel.safe_clearances(q.tolist())
+    for k, (body, frame) in enumerate(zip(arm.bodies, frames, strict=True)):
+        local = (points - frame[:3, 3]) @ frame[:3, :3]  # the points in the link's frame
+        exact = max(_hull_distances(body.hull.vertices, body.hull.triangles, local).min()
+                    - radius, 0.0)  # fmt: skip
+        # certain (no more than the distance), and within coal's allowance of it
+        assert scene[k] <= exact + 1e-9, (k, scene[k], exact)
+        assert scene[k] >= exact * (1 - 2 * COAL_CLEARANCE_RTOL) - 1e-4, (k, scene[k], exact)

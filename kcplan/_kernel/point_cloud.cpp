@@ -62,14 +62,24 @@ struct PointCloud::Query {
   coal::Matrix3s rotation;  // the shape's frame and its box there (coal's aabb_local)
   Vec3s origin, low, high;
   const Dop* dop = nullptr;  // a hull's supports along kDopDirections (its frame), or null
+  std::array<Vec3s, 26> dop_normals, dop_spans;  // those planes in the world: n, |n|
+  std::array<double, 26> dop_offsets;
 
   Query(const coal::CollisionObject& o, PointCloud& cloud)
       : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)) {
-    if (support.hull_support != nullptr) dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
     rotation = o.getTransform().getRotation();
     origin = o.getTransform().getTranslation();
     low = o.collisionGeometryPtr()->aabb_local.min_;
     high = o.collisionGeometryPtr()->aabb_local.max_;
+    if (support.hull_support != nullptr) {
+      dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
+      // the planes in the world: d . x <= h_d + d . t for the world's d = R d_local
+      for (std::size_t j = 0; j < kDopDirections.size(); ++j) {
+        dop_normals[j] = rotation * kDopDirections[j];
+        dop_offsets[j] = (*dop)[j] + dop_normals[j].dot(origin);
+        dop_spans[j] = dop_normals[j].cwiseAbs();
+      }
+    }
     scale = 1.0 + support.centre.norm() + std::abs(support.spread_high);
     ball = supported && support.hull == nullptr && !support.capsule &&
            support.spread_low == support.spread_high;
@@ -101,11 +111,12 @@ struct PointCloud::Query {
     const Vec3s local = rotation.transpose() * (m - origin);
     lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
     if (lower - slack >= best || !supported) return lower - slack;
-    if (dop != nullptr) {  // the hull lies in {x : d . x <= h_d} for each fixed direction d
+    if (dop != nullptr) {  // the hull lies in {x : n . x <= h} for each of the 26 planes,
+      // the box in {y : n . y >= n . m - |n| . half}
       double most = -std::numeric_limits<double>::infinity();
       for (std::size_t j = 0; j < kDopDirections.size(); ++j)
-        most = std::max(most, kDopDirections[j].dot(local) - (*dop)[j]);
-      lower = std::max(lower, most - rho);
+        most = std::max(most, dop_normals[j].dot(m) - dop_spans[j].dot(half) - dop_offsets[j]);
+      lower = std::max(lower, most);
       if (lower - slack >= best) return lower - slack;
     }
     const Vec3s d = m - support.centre;
