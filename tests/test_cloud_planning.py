@@ -123,3 +123,24 @@ def test_padding_on_a_sampling_planner_is_refused(capsys):
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--padding: kept by the kc-* and ca-* planners only" in err[0]
+
+
+def test_the_verifiers_point_surface_measures_every_point_from_below():
+    """kcplan.arm.verify.point_triangles: one FCL surface of the points, whose distance to
+    a shape is each point's to within POINT_TRIANGLE, from below."""
+    import fcl
+
+    from kcplan.arm.verify import POINT_TRIANGLE, point_triangles
+
+    rng = np.random.default_rng(5)
+    points = rng.uniform(-1, 1, (400, 3))
+    surface = fcl.CollisionObject(point_triangles(points))
+    box = fcl.Box(0.3, 0.2, 0.1)
+    for _ in range(20):
+        at = rng.uniform(-1.5, 1.5, 3)
+        obj = fcl.CollisionObject(box, fcl.Transform(at))
+        d = fcl.distance(obj, surface, fcl.DistanceRequest(), fcl.DistanceResult())
+        local = np.abs(points - at) - [0.15, 0.1, 0.05]  # exact point-to-box distances
+        exact = np.linalg.norm(np.maximum(local, 0.0), axis=1)
+        exact[(local <= 0).all(axis=1)] = 0.0
+        assert exact.min() - POINT_TRIANGLE - 1e-9 <= max(d, 0.0) <= exact.min() + 1e-9

@@ -30,6 +30,7 @@ from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
 from kcplan.arm.model import ArmModel
 from kcplan.arm.shapes import bvh_mesh
 from kcplan.world.collision import fcl_obstacle_parts
+from kcplan.world.pointcloud import CLOUD_KINDS
 from kcplan.world.scenario import Obstacle
 
 __all__ = ["ArmMeshChecker", "ArmPathCheck", "verify_arm_path"]
@@ -194,11 +195,16 @@ class ArmMeshChecker:
         ).reshape(-1, 2)
         self._rho = chain_speeds(arm, joints, reaches)
         self._rho_pairs = relative_speeds(self._rho, carries(arm, joints), self._pairs)
-        scene = []
+        scene, clouds = [], []
         for ob in obstacles:
+            if ob.kind in CLOUD_KINDS:  # one FCL surface of its points, less their radius
+                clouds.append((fcl.CollisionObject(point_triangles(ob.vertices)),
+                               float(ob.extents[0])))  # fmt: skip
+                continue
             for shape, tf in fcl_obstacle_parts(ob, 3):
                 scene.append(fcl.CollisionObject(shape, tf))
         self._scene = scene  # the manager keeps pointers to these objects
+        self._clouds = clouds
         self._manager = fcl.DynamicAABBTreeCollisionManager()
         if scene:
             self._manager.registerObjects(scene)
@@ -225,7 +231,7 @@ class ArmMeshChecker:
         to the mesh than to its hull); the meshes themselves only otherwise."""
         links = len(self._links)
         if item < links:
-            if not self._scene:
+            if not self._scene and not self._clouds:
                 return math.inf
             hull = self._hulls[item]
             if hull is not None:
@@ -276,9 +282,14 @@ class ArmMeshChecker:
         return (self._names[a], self._names[b])
 
     def _scene_distance(self, obj: fcl.CollisionObject) -> float:
-        result = fcl.DistanceData()
-        self._manager.distance(obj, result, fcl.defaultDistanceCallback)
-        return float(result.result.min_distance)
+        d = math.inf
+        if self._scene:
+            result = fcl.DistanceData()
+            self._manager.distance(obj, result, fcl.defaultDistanceCallback)
+            d = float(result.result.min_distance)
+        for cloud, radius in self._clouds:
+            d = min(d, _distance(obj, cloud) - radius)
+        return d
 
     def check(self, states: Sequence[ArrayLike], max_queries: int = 1_000_000) -> ArmPathCheck:
         """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints`
@@ -332,6 +343,25 @@ class ArmMeshChecker:
                         f"verify: more than {max_queries} queries on segment {index}"
                     )
         return ArmPathCheck(False, lowest, (), queries)
+
+
+POINT_TRIANGLE = 1e-9
+"""Metres: the legs of the triangle that stands for one point of a cloud (point_triangles)."""
+
+
+def point_triangles(points: NDArray[np.float64]) -> fcl.BVHModel:
+    """A cloud's points as one FCL surface: point ``p`` the triangle ``(p, p + e x, p + e
+    y)``, ``e`` = :data:`POINT_TRIANGLE`. The triangle holds ``p``, so a shape's distance to
+    it never exceeds its distance to ``p``: FCL's BVH (its own, not coal's, and not the
+    kernel's tree) then measures a shape's distance to every point at once, from below by at
+    most ``e``."""
+    p = np.asarray(points, dtype=float)
+    vertices = np.stack([p, p + [POINT_TRIANGLE, 0.0, 0.0], p + [0.0, POINT_TRIANGLE, 0.0]], axis=1)
+    model = fcl.BVHModel()
+    model.beginModel(3 * len(p), len(p))
+    model.addSubModel(vertices.reshape(-1, 3), np.arange(3 * len(p)).reshape(-1, 3))
+    model.endModel()
+    return model
 
 
 def _distance(a: fcl.CollisionObject, b: fcl.CollisionObject) -> float:

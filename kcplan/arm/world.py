@@ -34,6 +34,7 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import ArmModel
 from kcplan.arm.pairs import prove_pairs as prove_pairs_of
 from kcplan.world.collision import CLEARANCE_ATOL, CLEARANCE_RTOL, fcl_obstacle_parts
+from kcplan.world.pointcloud import CLOUD_KINDS
 from kcplan.world.scenario import Obstacle
 from kcplan.world.support import EllipsoidSupport, PointsSupport, piece_supports, separation
 
@@ -125,7 +126,7 @@ class ArmWorld:
                 for ob in self.obstacles
                 for corner in (
                     (ob.vertices.min(axis=0), ob.vertices.max(axis=0))
-                    if ob.kind in ("pointcloud", "depth")
+                    if ob.kind in CLOUD_KINDS
                     else (ob.center,)
                 )
             ] or [np.zeros(3)]

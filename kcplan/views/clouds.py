@@ -13,9 +13,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.world.pointcloud import CLOUD_KINDS
+
 __all__ = [
     "CLOUD_COLORMAP",
-    "CLOUD_KINDS",
     "MAX_DRAWN_POINTS",
     "cloud_points_for_display",
     "clouds_of",
@@ -28,8 +29,6 @@ __all__ = [
 MAX_DRAWN_POINTS = 20_000
 """Most points drawn of one cloud (a deterministic subsample beyond: a page or a picture
 of millions of points is slow to draw and no clearer)."""
-CLOUD_KINDS = ("pointcloud", "depth")
-"""The obstacle kinds that are points (:class:`kcplan.world.scenario.Obstacle`)."""
 CLOUD_COLORMAP = "viridis"
 """The colour map of a cloud's points by height (matplotlib's name; plotly's ``Viridis``)."""
 

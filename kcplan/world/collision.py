@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 from kcplan._kernel import _core, build_kernel_world
 from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
+from kcplan.world.pointcloud import CLOUD_KINDS
 from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Obstacle, Scenario, as_rigid_scenario
 from kcplan.world.support import EllipsoidSupport, box_vertices, piece_supports, separation
@@ -120,7 +121,7 @@ def fcl_obstacle_parts(ob: Obstacle, n: int, half_height: float = 1.0) -> list[t
     if ob.kind == "convex":
         faces = np.column_stack([np.full(len(ob.triangles), 3), ob.triangles]).ravel()
         return [(fcl.Convex(ob.vertices, len(ob.triangles), faces.astype(np.int32)), identity)]
-    if ob.kind in ("pointcloud", "depth"):  # each point a ball of the planning radius
+    if ob.kind in CLOUD_KINDS:  # each point a ball of the planning radius
         radius = float(ob.extents[0])  # a geometry each: supports are keyed by geometry
         return [(fcl.Sphere(radius), fcl.Transform(p)) for p in ob.vertices]
     if ob.kind == "mesh":

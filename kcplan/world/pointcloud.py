@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "CLOUD_KINDS",
     "MAX_CLOUD_BYTES",
     "MAX_DEPTH_PIXELS",
     "POINT_FORMATS",
@@ -51,6 +52,8 @@ memory: 44 million float32 points of a binary PLY)."""
 MAX_DEPTH_PIXELS = 50_000_000
 """Largest depth image read, in pixels (PNG compresses a constant image to almost
 nothing: the size is checked before the pixels are decoded)."""
+CLOUD_KINDS = ("pointcloud", "depth")
+"""The scenario obstacle kinds whose points are sensed: a cloud, or a depth image's."""
 POINT_FORMATS = (".ply", ".pcd", ".xyz", ".npy")
 """File extensions :func:`read_point_file` reads (case-insensitive)."""
 DEPTH_FORMATS = (".png", ".npy")

@@ -41,6 +41,7 @@ from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
 from kcplan.world.mesh import convex_hull, read_mesh
 from kcplan.world.pointcloud import (
+    CLOUD_KINDS,
     CloudInfo,
     PointCloudError,
     crop_box_mask,
@@ -421,7 +422,7 @@ def parse_obstacle(r: FieldReader, value: Any, index: int, n: int, directory: Pa
             f"expected one of {', '.join(kinds)} in {n}D"
         )
     where = f"{where}.{kind}"
-    if kind in ("pointcloud", "depth"):
+    if kind in CLOUD_KINDS:
         return _cloud_obstacle(r, kind, spec, where, index, directory)
     angle = ("yaw",) if n == 2 else ("quaternion",)
     eye, zeros = np.eye(n), np.zeros(n)

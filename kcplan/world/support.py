@@ -17,6 +17,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.world.pointcloud import CLOUD_KINDS
+
 __all__ = [
     "BallSupport",
     "CylinderSupport",
@@ -127,7 +129,7 @@ def piece_supports(obstacle) -> list:
         return [PointsSupport(box_vertices(obstacle.center, obstacle.rotation, obstacle.extents))]
     if kind in ("circle", "sphere"):
         return [BallSupport(obstacle.center, obstacle.extents[0])]
-    if kind in ("pointcloud", "depth"):
+    if kind in CLOUD_KINDS:
         return [BallSupport(p, obstacle.extents[0]) for p in obstacle.vertices]
     if kind in ("ellipse", "ellipsoid"):
         return [EllipsoidSupport(obstacle.center, obstacle.rotation, obstacle.extents)]
