@@ -132,3 +132,12 @@ def assert_planner_refused(scenario, name: str, line: str, why: str, tmp_path, c
     assert not (tmp_path / "bench").exists()
     with pytest.raises(ValueError, match=f"^{re.escape(f'planner: {name}: {why}')}"):
         plan(scenario, name, time_limit=0.05)
+
+
+def sphere_points(n: int) -> np.ndarray:
+    """n nearly even unit vectors (a Fibonacci lattice), shape (n, 3)."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    phi = np.pi * (1.0 + 5**0.5) * i
+    r = np.sqrt(1.0 - z * z)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])

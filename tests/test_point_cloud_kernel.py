@@ -9,6 +9,7 @@ body's distance) and the exact distance of a ball query."""
 import coal
 import numpy as np
 import pytest
+from conftest import sphere_points
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -20,16 +21,9 @@ from kcplan._kernel import World as KernelWorld
 SURFACE = 4000
 
 
-def _unit(n: int) -> np.ndarray:
-    """n nearly even unit vectors (a Fibonacci lattice), shape (n, 3)."""
-    i = np.arange(n) + 0.5
-    z = 1.0 - 2.0 * i / n
-    phi = np.pi * (1.0 + 5**0.5) * i
-    r = np.sqrt(1.0 - z * z)
-    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
 
 
-UNIT = _unit(SURFACE)
+UNIT = sphere_points(SURFACE)
 
 
 def _world(points: np.ndarray, radius: float, axes) -> KernelWorld:
@@ -66,7 +60,7 @@ def clouds(draw):
     elif kind == "plane":
         points = np.column_stack([rng.uniform(-1, 1, (n, 2)), np.full(n, draw(f(-0.6, 0.6)))])
     else:
-        points = draw(f(0.3, 1.5)) * _unit(n)
+        points = draw(f(0.3, 1.5)) * sphere_points(n)
     points = points + rng.uniform(-0.3, 0.3, 3)
     radius = draw(f(1e-4, 0.05))
     axes = [draw(f(0.02, 0.4)) for _ in range(3)]

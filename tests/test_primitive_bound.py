@@ -5,6 +5,7 @@ verdict of such a world is checked here against exact point-to-primitive distanc
 points sampled densely on the body's surface, independent of coal."""
 
 import numpy as np
+from conftest import sphere_points
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -17,16 +18,9 @@ KINDS = ("box", "ball", "cylinder")
 SURFACE = 6000  # sampled points of the body's surface
 
 
-def _sphere_points(n: int) -> np.ndarray:
-    """n nearly even unit vectors (a Fibonacci lattice), shape (n, 3)."""
-    i = np.arange(n) + 0.5
-    z = 1.0 - 2.0 * i / n
-    phi = np.pi * (1.0 + 5**0.5) * i
-    r = np.sqrt(1.0 - z * z)
-    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
 
 
-UNIT = _sphere_points(SURFACE)
+UNIT = sphere_points(SURFACE)
 
 
 def _distance(kind: str, centre, R, size, points: np.ndarray) -> np.ndarray:

@@ -20,6 +20,9 @@ C++ (``kcplan/_kernel/``)               Python twin
                                         FCL's BVH; tested against it
 ``primitive_bound.hpp`` ``Primitive``   none: a shortcut before GJK for boxes, balls
                                         and cylinders; tested against exact distances
+``point_cloud.hpp`` ``PointCloud``      each point an FCL ball
+                                        (:func:`kcplan.world.collision.fcl_obstacle_parts`);
+                                        tested against measuring every point
 ``chain.hpp`` ``Chain``                 :mod:`kcplan.arm.kinematics`, :mod:`kcplan.arm.bounds`
 ``arm_world.hpp`` ``ArmWorld``          :class:`kcplan.arm.ArmWorld`
 ``pair_motion.hpp`` ``PairFirstOrder``  :func:`kcplan.arm.bounds.relative_first_order`
