@@ -510,7 +510,9 @@ def test_the_lazy_planner_returns_a_certified_rigid_path(name, planner):
     assert c["kc_lazy_attempts"] == c["kc_lazy_rejected_paths"] + 1
     if planner.endswith("-restart"):
         assert c["kc_lazy_repaired_edges"] == 0
-    assert c["kc_screened_edges"] >= edges and c["kc_edges"] <= c["kc_lazy_attempts"] * edges
+    assert c["kc_screened_edges"] >= edges
+    if c["kc_lazy_repaired_edges"] == 0:  # a repair certifies the edges of its own plan too
+        assert c["kc_edges"] <= c["kc_lazy_attempts"] * edges
     fresh = EdgeCertifier(CollisionWorld(scenario))
     states = result.states
     assert all(fresh.check(a, b) for a, b in zip(states, states[1:], strict=False))
