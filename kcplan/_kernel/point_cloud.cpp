@@ -65,13 +65,16 @@ struct PointCloud::Query {
   std::array<Vec3s, 26> dop_normals, dop_spans;  // those planes in the world: n, |n|
   std::array<double, 26> dop_offsets;
 
+  CloudBounds use;
+
   Query(const coal::CollisionObject& o, PointCloud& cloud)
-      : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)) {
+      : object(&o), box(&o.getAABB()), supported(ShapeSupport::of(o, support)),
+        use(cloud.bounds_used) {
     rotation = o.getTransform().getRotation();
     origin = o.getTransform().getTranslation();
     low = o.collisionGeometryPtr()->aabb_local.min_;
     high = o.collisionGeometryPtr()->aabb_local.max_;
-    if (support.hull_support != nullptr) {
+    if (support.hull_support != nullptr && use.dop) {
       dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
       // the planes in the world: d . x <= h_d + d . t for the world's d = R d_local
       for (std::size_t j = 0; j < kDopDirections.size(); ++j) {
@@ -87,7 +90,7 @@ struct PointCloud::Query {
 
   /// Keep the plane across unit `n` that touches the shape (its support there).
   void add_plane(const Vec3s& n) {
-    if (!supported) return;
+    if (!supported || !use.gjk_planes) return;
     normals[next] = n;
     offsets[next] = n.dot(support.centre) + support.spread(n);
     next = (next + 1) % kPlanes;
@@ -108,8 +111,10 @@ struct PointCloud::Query {
     if (lower - slack >= best) return lower - slack;
     // the gap to the shape's own box in its frame (a link's box is far tighter than the
     // world's box of it when the link lies slanted)
-    const Vec3s local = rotation.transpose() * (m - origin);
-    lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
+    if (use.own_box) {
+      const Vec3s local = rotation.transpose() * (m - origin);
+      lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
+    }
     if (lower - slack >= best || !supported) return lower - slack;
     if (dop != nullptr) {  // the hull lies in {x : n . x <= h} for each of the 26 planes,
       // the box in {y : n . y >= n . m - |n| . half}
@@ -127,7 +132,8 @@ struct PointCloud::Query {
     for (int j = 0; j < planes; ++j)
       lower = std::max(lower, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
     if (lower - slack >= best) return lower - slack;
-    if (length > 0.0) lower = std::max(lower, length - support.spread(d / length) - rho);
+    if (length > 0.0 && use.centre_line)
+      lower = std::max(lower, length - support.spread(d / length) - rho);
     return lower - slack;
   }
 };

@@ -27,6 +27,15 @@ struct CloudCounters {
   std::int64_t exact = 0;    ///< points measured by coal's GJK (their bound did not decide)
 };
 
+/// Which of a cloud's cheaper bounds are asked before GJK (all by default; switched off
+/// only to measure what each buys: the answers are the same, the work is not).
+struct CloudBounds {
+  bool own_box = true;      ///< the shape's box in its own frame
+  bool dop = true;          ///< a hull's 26 fixed planes
+  bool gjk_planes = true;   ///< the planes GJK's nearest points have shown in this query
+  bool centre_line = true;  ///< the shape's support along the centres' line
+};
+
 /// The union of the balls of radius `radius()` about the points, as an obstacle.
 ///
 /// The points are kept in a k-d tree (median splits along a box's longest side, leaves of
@@ -95,6 +104,7 @@ class PointCloud {
   double support(const coal::AABB& region, const coal::Vec3s& n) const;
 
   CloudCounters counters;
+  CloudBounds bounds_used;
 
  private:
   struct Node {

@@ -201,6 +201,12 @@ class World {
   const Robot& robot() const { return robot_; }
   /// The point clouds' work, summed over every cloud.
   CloudCounters cloud_counters() const;
+  /// Which cheaper bounds every cloud asks before GJK (PointCloud::bounds_used; for
+  /// ablations: the answers stay the same).
+  void set_cloud_bounds(const CloudBounds& bounds) {
+    for (auto& cloud : clouds_)
+      if (cloud) cloud->bounds_used = bounds;
+  }
   void reset_cloud_counters() {
     for (auto& cloud : clouds_)
       if (cloud) cloud->counters = CloudCounters{};
