@@ -213,7 +213,7 @@ def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
     kernel = ArmWorld(arm, [cloud], prove_pairs=False).kernel
     scene, _ = kernel.safe_clearances(q.tolist())
     # the cheaper bounds change the work, not the answers
-    kernel.scene.set_cloud_bounds(own_box=False, dop=False, gjk_planes=False, centre_line=False)
+    kernel.scene.set_cloud_bounds(dop=False, gjk_planes=False, centre_line=False)
     bare, _ = kernel.safe_clearances(q.tolist())
     np.testing.assert_allclose(bare, scene, rtol=1e-5, atol=2e-6)
     for k, (body, frame) in enumerate(zip(arm.bodies, frames, strict=True)):

@@ -199,10 +199,10 @@ NB_MODULE(_core, m) {
       .def_prop_ro("cloud_counters", &cloud_counters)
       .def(
           "set_cloud_bounds",
-          [](kcplan::World& w, bool own_box, bool dop, bool gjk_planes, bool centre_line) {
-            w.set_cloud_bounds(kcplan::CloudBounds{own_box, dop, gjk_planes, centre_line});
+          [](kcplan::World& w, bool dop, bool gjk_planes, bool centre_line) {
+            w.set_cloud_bounds(kcplan::CloudBounds{dop, gjk_planes, centre_line});
           },
-          "own_box"_a = true, "dop"_a = true, "gjk_planes"_a = true, "centre_line"_a = true,
+          "dop"_a = true, "gjk_planes"_a = true, "centre_line"_a = true,
           "Which cheaper bounds the clouds ask before GJK (point_cloud.hpp CloudBounds)")
       .def_prop_ro("body_query_counts", [](const kcplan::World& w) { return w.body_query_counts; })
       .def("reset_counters", [](kcplan::World& w) {

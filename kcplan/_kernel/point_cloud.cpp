@@ -59,8 +59,8 @@ struct PointCloud::Query {
 
   bool ball;  // the shape is a ball: a point's bound along the centres' line is exact
 
-  coal::Matrix3s rotation;  // the shape's frame and its box there (coal's aabb_local)
-  Vec3s origin, low, high;
+  coal::Matrix3s rotation;  // the shape's frame
+  Vec3s origin;
   const Dop* dop = nullptr;  // a hull's supports along kDopDirections (its frame), or null
   std::array<Vec3s, 26> dop_normals, dop_spans;  // those planes in the world: n, |n|
   std::array<double, 26> dop_offsets;
@@ -72,8 +72,6 @@ struct PointCloud::Query {
         use(cloud.bounds_used) {
     rotation = o.getTransform().getRotation();
     origin = o.getTransform().getTranslation();
-    low = o.collisionGeometryPtr()->aabb_local.min_;
-    high = o.collisionGeometryPtr()->aabb_local.max_;
     if (support.hull_support != nullptr && use.dop) {
       dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
       // the planes in the world: d . x <= h_d + d . t for the world's d = R d_local
@@ -99,9 +97,9 @@ struct PointCloud::Query {
 
   /// A lower bound of the distance from the shape to any point of the box about `m` of
   /// half sides `half` (a point: half = 0), less rounding, or a number at least `best`
-  /// as soon as one is known (the cheap bounds first: the boxes' gap, the gap to the
-  /// shape's box in its own frame, a hull's 26 fixed planes, its bounding ball, the kept
-  /// planes, and only then the support along the centres' line).
+  /// as soon as one is known (the cheap bounds first: the boxes' gap, a hull's 26 fixed
+  /// planes, its bounding ball, the kept planes, and only then, for a shape other than a
+  /// polytope, the support along the centres' line).
   double bound(const Vec3s& m, const Vec3s& half, double best) const {
     const double rho = half.norm();
     const double slack = 1e-12 * (scale + m.norm() + rho);
@@ -109,13 +107,7 @@ struct PointCloud::Query {
     const Vec3s out = (b.min_ - half - m).cwiseMax(m - half - b.max_).cwiseMax(0.0);
     double lower = out.norm();
     if (lower - slack >= best) return lower - slack;
-    // the gap to the shape's own box in its frame (a link's box is far tighter than the
-    // world's box of it when the link lies slanted)
-    if (use.own_box) {
-      const Vec3s local = rotation.transpose() * (m - origin);
-      lower = std::max(lower, (low - local).cwiseMax(local - high).cwiseMax(0.0).norm() - rho);
-    }
-    if (lower - slack >= best || !supported) return lower - slack;
+    if (!supported) return lower - slack;
     if (dop != nullptr) {  // the hull lies in {x : n . x <= h} for each of the 26 planes,
       // the box in {y : n . y >= n . m - |n| . half}
       double most = -std::numeric_limits<double>::infinity();
@@ -132,7 +124,9 @@ struct PointCloud::Query {
     for (int j = 0; j < planes; ++j)
       lower = std::max(lower, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
     if (lower - slack >= best) return lower - slack;
-    if (length > 0.0 && use.centre_line)
+    // a polytope's support is a scan of its vertices: it cost more than it saved
+    // (scripts/cloud_bounds.py), so hulls go to GJK here; an ellipsoid's is one product
+    if (length > 0.0 && use.centre_line && support.hull == nullptr)
       lower = std::max(lower, length - support.spread(d / length) - rho);
     return lower - slack;
   }

@@ -30,10 +30,9 @@ struct CloudCounters {
 /// Which of a cloud's cheaper bounds are asked before GJK (all by default; switched off
 /// only to measure what each buys: the answers are the same, the work is not).
 struct CloudBounds {
-  bool own_box = true;      ///< the shape's box in its own frame
   bool dop = true;          ///< a hull's 26 fixed planes
   bool gjk_planes = true;   ///< the planes GJK's nearest points have shown in this query
-  bool centre_line = true;  ///< the shape's support along the centres' line
+  bool centre_line = true;  ///< the support along the centres' line (not for hulls)
 };
 
 /// The union of the balls of radius `radius()` about the points, as an obstacle.
@@ -44,10 +43,10 @@ struct CloudBounds {
 /// ShapeSupport describes) is measured against a node by two lower bounds of the distance
 /// from S to any point of the node's box B, and the larger is used:
 ///
-///  - the gap between S's world bounding box and B (S lies in its box), and between S's
-///    box in its own frame (coal's aabb_local) and B's bounding ball (B about m lies
-///    within rho = |half| of m);
-///  - S's separation along n = (m - c) / |m - c|, c S's centre and m B's centre:
+///  - the gap between S's world bounding box and B (S lies in its box);
+///  - for a shape other than a polytope (for a hull the scan of its vertices cost more
+///    than it saved: scripts/cloud_bounds.py), S's separation along n = (m - c) / |m - c|,
+///    c S's centre and m B's centre:
 ///    every x of S has n . x <= n . c + spread_S(n) and every y of B has
 ///    n . y >= n . m - rho (rho B's half diagonal), so |y - x| >= n . (y - x) >=
 ///    |m - c| - spread_S(n) - rho.
