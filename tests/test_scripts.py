@@ -202,6 +202,21 @@ CASES = [
             r"; planes: \d+ took a body farther$",
         ),
     ),
+    Case(  # against point clouds (issue 55): filtered for the certifier, re-checked raw
+        "arm_soundness.py",
+        ("--edges", "14", "--per-class", "1", "--representation", "hulls", "--cloud", "100")
+        + ("--spacing", "0.02", "--graze", "0.5"),
+        (
+            r"^\| panda \| kernel \| 14 \| \d+ \| 0 \| ",
+            r"^- grazing \(--graze 0.5\): \d+ edges cut short to end near an invalid state, ",
+            rf"^- smallest distance the mesh re-check measured on an accepted edge: {NUMBER}",
+            r"^\| robot \| scenes \| points per scene \| filter \| kept for the certifier \| ",
+            rf"^\| panda \| 7 \| [\d,]+ \([\d,]+-[\d,]+\) \| voxel 0.02 \| [\d,]+ \({NUMBER} %\) "
+            rf"\| 0.0225 / 0.0025 \| 14 \| ([1-9]\d*) \| \1 \| 0 \| {NUMBER}(?:e-\d+)? "
+            r"\| \d+ / \d+ \|$",
+            r"^- 100 surface points per object, seed 1; every accepted edge re-checked on the ",
+        ),
+    ),
     Case(
         "edge_outcomes.py",
         (CORRIDOR, "kc-rrtconnect", "1,2", "--probes", "1", "--time", "5"),
@@ -444,6 +459,19 @@ CASES.append(
             r"^box_field_cloud\.yaml: solved in .* 6,000 points read, 6,000 kept",
         ),
         ("arm/box_1_cloud.yaml", "arm/clouds/table_pick_1_depth.png", "3d/clouds/box_field.ply"),
+    )
+)
+
+
+CASES.append(
+    Case(  # one seed on the depth scene: every setting solves, the bare tree measures more
+        "cloud_bounds.py",
+        ("--seeds", "1", "scenarios/arm/table_pick_1_depth.yaml"),
+        (
+            r"^\| scenario \| bounds \| solved \| solve, median ms \| ",
+            rf"^\| table_pick_1_depth \| all \| 1 / 1 \| {NUMBER} \| {NUMBER} \| ",
+            rf"^\| table_pick_1_depth \| none \| 1 / 1 \| {NUMBER} \| {NUMBER} \| ",
+        ),
     )
 )
 
