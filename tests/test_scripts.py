@@ -476,6 +476,15 @@ CASES.append(
 )
 
 
+CASES.append(
+    Case(  # VAMP-CAPT beside kcplan on MBM clouds: its options (a run takes minutes)
+        "cloud_mbm.py",
+        ("--help",),
+        (r"^usage: cloud_mbm\.py ",),
+    )
+)
+
+
 @pytest.mark.skipif(HAVE_VAMP, reason="VAMP is installed here")
 def test_vamp_mbm_without_vamp_says_how_to_build_it():
     proc = subprocess.run(
