@@ -464,6 +464,22 @@ CASES.append(
 
 
 CASES.append(
+    Case(  # KC vs the clearance ball on one scene and its cloud, each path verified
+        "cloud_kc_ablation.py",
+        ("--scenes", "peg_in_hole", "--hrm-maps", "--runs", "1", "--time", "5")
+        + ("--spacing", "1", "--work", "{tmp}"),
+        (
+            r"^\| scene \| obstacles \(primitives / points\) \| primitives: kc solved, ",
+            rf"^\| peg_in_hole \| 5 \(5 box\) / [\d,]+ \| 1/1, {NUMBER}(?:e-\d+)? s, [\d,]+ \| "
+            rf"1/1, {NUMBER}(?:e-\d+)? s, [\d,]+ \| {NUMBER} \| 1/1, .* \| {NUMBER} \|$",
+            r"^- colliding paths: 0 of 4 returned paths, .* failed runs: 0 of 4$",
+        ),
+        ("runs.jsonl", "peg_in_hole_points.yaml", "clouds/peg_in_hole.ply"),
+    )
+)
+
+
+CASES.append(
     Case(  # one seed on the depth scene: every setting solves, the bare tree measures more
         "cloud_bounds.py",
         ("--seeds", "1", "scenarios/arm/table_pick_1_depth.yaml"),
