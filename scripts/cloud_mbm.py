@@ -677,6 +677,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.archive is None:
         args.archive = os.fspath(MBM / args.robot / "problems.tar.bz2")
+    if args.json and args.step is None:  # the steps may run in another folder (ROOT)
+        args.json = os.path.abspath(args.json)
     args.classes = [c for c in args.classes.split(",") if c]
     unknown = [c for c in args.classes if c not in CLASSES]
     if unknown or not args.classes:

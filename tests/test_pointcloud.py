@@ -554,7 +554,7 @@ def test_an_arm_scenario_reads_clouds(tmp_path):
     _depth_png(tmp_path / "scans")
     data["obstacles"] += [
         {"pointcloud": {"file": "scans/shelf.npy", "point_radius": 0.005, "spacing": 0.01,
-                        "position": [0.5, 0.0, 0.4], "self_filter": 0.03}},
+                        "position": [0.5, 0.0, 0.4], "self_filter": 0.005}},
         {"depth": {"image": "scans/d.png", "intrinsics": {"fx": 5, "fy": 5, "cx": 3, "cy": 2},
                    "max_range": 2.0, "point_radius": 0.01, "position": [1.5, 0, 1],
                    "quaternion": [0.5, -0.5, 0.5, -0.5]}},
@@ -565,7 +565,7 @@ def test_an_arm_scenario_reads_clouds(tmp_path):
     cloud, depth = scenario.obstacles[-2:]
     assert cloud.kind == "pointcloud" and depth.kind == "depth"
     assert cloud.vertices == pytest.approx(POINTS * 0.1 + [0.5, 0.0, 0.4])  # none closer than 0.01
-    assert cloud.extents.tolist() == pytest.approx([0.015] * 3) and cloud.cloud.self_filter == 0.03
+    assert cloud.extents.tolist() == pytest.approx([0.015] * 3) and cloud.cloud.self_filter == 0.005
     assert len(depth.vertices) == 22
     dumped = tmp_path / "again.yaml"
     dump_scenario(scenario, dumped)
