@@ -48,7 +48,20 @@ from __future__ import annotations
 import numpy as np
 
 from kcplan._kernel import _core
-from kcplan._kernel._core import ArmCertifier, ArmWorld, Chain, EdgeCertifier, Robot, World
+from kcplan._kernel._core import (
+    ArmCertifier,
+    ArmMotionValidator,
+    ArmPlan,
+    ArmRRTConnect,
+    ArmWorld,
+    CertifiedArmMotions,
+    Chain,
+    DiscreteArmMotions,
+    EdgeCertifier,
+    Robot,
+    ScreenedArmMotions,
+    World,
+)
 
 __all__ = [
     "COAL_CLEARANCE_ATOL",
@@ -58,8 +71,14 @@ __all__ = [
     "Robot",
     "World",
     "ArmCertifier",
+    "ArmMotionValidator",
+    "ArmPlan",
+    "ArmRRTConnect",
     "ArmWorld",
+    "CertifiedArmMotions",
     "Chain",
+    "DiscreteArmMotions",
+    "ScreenedArmMotions",
     "add_obstacles",
     "build_kernel_arm",
     "build_kernel_world",

@@ -8,6 +8,8 @@
 #include <nanobind/stl/vector.h>
 
 #include "arm_certifier.hpp"
+#include "arm_motion_validator.hpp"
+#include "arm_planner.hpp"
 #include "certifier.hpp"
 #include "enclosing.hpp"
 #include "pair_proof.hpp"
@@ -106,6 +108,14 @@ const double* joints_of(const kcplan::Chain& chain, const std::vector<double>& q
     throw std::invalid_argument("state: expected " + std::to_string(chain.dof()) +
                                 " joint values, got " + std::to_string(q.size()));
   return q.data();
+}
+
+/// The rows of a flat vector of `dof`-number states.
+std::vector<std::vector<double>> rows_of(const std::vector<double>& flat, int dof) {
+  std::vector<std::vector<double>> out;
+  for (std::size_t i = 0; i + dof <= flat.size(); i += dof)
+    out.emplace_back(flat.begin() + i, flat.begin() + i + dof);
+  return out;
 }
 
 }  // namespace
@@ -528,4 +538,58 @@ NB_MODULE(_core, m) {
       .def_prop_ro("first_order", &kcplan::ArmCertifier::first_order)
       .def_prop_ro("kc_inflation", &kcplan::ArmCertifier::kc_inflation)
       .def_prop_ro("planes", &kcplan::ArmCertifier::planes);
+
+  nb::class_<kcplan::ArmMotionValidator>(m, "ArmMotionValidator",
+      "Decides an arm's straight edge for the compiled planner "
+      "(kcplan/_kernel/arm_motion_validator.hpp)")
+      .def("check", [](kcplan::ArmMotionValidator& v, const std::vector<double>& q1,
+                       const std::vector<double>& q2) {
+        return v.check(joints_of(v.chain(), q1), joints_of(v.chain(), q2));
+      }, "q1"_a, "q2"_a, "Whether the edge q1 -> q2 may be used (q1 assumed valid)")
+      .def("state_valid", [](kcplan::ArmMotionValidator& v, const std::vector<double>& q) {
+        return v.state_valid(joints_of(v.chain(), q));
+      }, "q"_a)
+      .def_prop_ro("certified", &kcplan::ArmMotionValidator::certified)
+      .def_ro("edges", &kcplan::ArmMotionValidator::edges);
+  nb::class_<kcplan::CertifiedArmMotions, kcplan::ArmMotionValidator>(m, "CertifiedArmMotions")
+      .def(nb::init<kcplan::ArmCertifier&>(), "certifier"_a, nb::keep_alive<1, 2>());
+  nb::class_<kcplan::ScreenedArmMotions, kcplan::ArmMotionValidator>(m, "ScreenedArmMotions")
+      .def(nb::init<kcplan::ArmCertifier&, double>(), "certifier"_a, "step"_a,
+           nb::keep_alive<1, 2>())
+      .def_prop_ro("step", &kcplan::ScreenedArmMotions::step);
+  nb::class_<kcplan::DiscreteArmMotions, kcplan::ArmMotionValidator>(m, "DiscreteArmMotions")
+      .def(nb::init<kcplan::ArmWorld&, double>(), "world"_a, "step"_a, nb::keep_alive<1, 2>())
+      .def_ro("states", &kcplan::DiscreteArmMotions::states);
+
+  nb::class_<kcplan::ArmPlan>(m, "ArmPlan", "What ArmRRTConnect.solve did")
+      .def_ro("solved", &kcplan::ArmPlan::solved)
+      .def_ro("solve_seconds", &kcplan::ArmPlan::solve_seconds)
+      .def_ro("simplify_seconds", &kcplan::ArmPlan::simplify_seconds)
+      .def_ro("iterations", &kcplan::ArmPlan::iterations)
+      .def_ro("tree_states", &kcplan::ArmPlan::tree_states)
+      .def_ro("tree_edges", &kcplan::ArmPlan::tree_edges)
+      .def_ro("path_edges", &kcplan::ArmPlan::path_edges)
+      .def_ro("repaired_edges", &kcplan::ArmPlan::repaired_edges)
+      .def_ro("attempts", &kcplan::ArmPlan::attempts)
+      .def_ro("shortcut_edges", &kcplan::ArmPlan::shortcut_edges);
+
+  nb::class_<kcplan::ArmRRTConnect>(m, "ArmRRTConnect",
+      "RRT-Connect for arms in C++ (kcplan/_kernel/arm_planner.hpp)")
+      .def(nb::init<const kcplan::Chain&, kcplan::ArmMotionValidator&,
+                    kcplan::ArmMotionValidator*>(),
+           "chain"_a, "tree"_a, "path"_a.none() = nullptr, nb::keep_alive<1, 2>(),
+           nb::keep_alive<1, 3>(), nb::keep_alive<1, 4>())
+      .def("solve", [](kcplan::ArmRRTConnect& p, const std::vector<double>& start, const std::vector<double>& goal,
+                       double range, double time_limit, std::uint64_t seed, bool simplify,
+                       double repair_share) {
+        const kcplan::Chain& chain = p.chain();
+        kcplan::ArmPlannerOptions o;
+        o.range = range, o.time_limit = time_limit, o.seed = seed, o.simplify = simplify;
+        o.repair_share = repair_share;
+        kcplan::ArmPlan plan = p.solve(joints_of(chain, start), joints_of(chain, goal), o);
+        return nb::make_tuple(plan, rows_of(plan.path, chain.dof()),
+                              rows_of(plan.raw_path, chain.dof()));
+      }, "start"_a, "goal"_a, "range"_a, "time_limit"_a, "seed"_a = 0,
+      "simplify"_a = true, "repair_share"_a = 1.0,
+      "(ArmPlan, path rows, raw path rows) of one search from start to goal");
 }

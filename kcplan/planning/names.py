@@ -55,6 +55,14 @@ ARM_ONLY = {
     "only an arm's joint space has",
     "rrtconnect-pin": "stock RRT-Connect checking states with Pinocchio's computeCollisions "
     "on the link covers of a URDF robot",
+    "kc-rrtconnect-native": "RRT-Connect compiled beside the arm certifier, every edge "
+    "certified (kcplan.planning.native)",
+    "kc-rrtconnect-lazy-native": "kc-rrtconnect-native screening its trees' edges and "
+    "certifying the path it returns, as kc-rrtconnect-lazy",
+    "rrtconnect-32-native": "the compiled RRT-Connect checking an edge every 1/32 rad of "
+    "joint-space distance on the same hulls (the stock twin of kc-rrtconnect-native)",
+    "rrtconnect-native": "the compiled RRT-Connect checking an edge at OMPL's default "
+    "resolution (1 % of the joint box's diagonal) on the same hulls",
 }
 """Planners for arms only, with what they are (the reason a rigid robot is refused)."""
 

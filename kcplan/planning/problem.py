@@ -14,6 +14,7 @@ import os
 import time
 from dataclasses import dataclass, field, replace
 
+import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
@@ -22,6 +23,7 @@ from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.lazy import solve_lazily
+from kcplan.planning.native import solve_natively
 from kcplan.planning.names import (
     CERTIFIABLE,
     JOINT_STEP,
@@ -76,6 +78,7 @@ class PlannerSpec:
     learn_schedule: bool = True  # rigid (kc): the grid learns cells only while it pays
     lazy: bool = False  # kc: screen the trees' edges, certify the path (planning.lazy)
     lazy_repair: bool = True  # lazy: a rejected edge replaced by a certified sub-plan
+    native: bool = False  # arms: the compiled RRT-Connect (planning.native), not OMPL's
 
     @property
     def kc(self) -> bool:
@@ -278,6 +281,30 @@ PLANNERS["rrtconnect-pin"] = PlannerSpec(
     description="stock RRT-Connect, arms only: a Python isValid calling Pinocchio's "
     "computeCollisions on the same ellipsoid cover (kcplan.planning.pin_checker)",
     backend="pin",
+)
+PLANNERS["kc-rrtconnect-native"] = replace(
+    PLANNERS["kc-rrtconnect"],
+    description="arms only: RRT-Connect compiled beside the certifier (sampling, nearest "
+    "neighbours, extension and shortcuts in C++), every edge certified as kc-rrtconnect's",
+    native=True,
+)
+PLANNERS["kc-rrtconnect-lazy-native"] = replace(
+    PLANNERS["kc-rrtconnect-lazy"],
+    description="arms only: kc-rrtconnect-native screening its trees' edges and certifying "
+    "the path it returns, a rejected edge repaired by a certified sub-plan",
+    native=True,
+)
+PLANNERS["rrtconnect-32-native"] = replace(
+    PLANNERS["rrtconnect-32"],
+    description="arms only: the compiled RRT-Connect of kc-rrtconnect-native checking states "
+    "every 1/32 rad on the same hulls (its stock twin; not a proof)",
+    native=True,
+)
+PLANNERS["rrtconnect-native"] = replace(
+    PLANNERS["rrtconnect"],
+    description="arms only: the compiled RRT-Connect checking states at OMPL's default "
+    "resolution (1 % of the joint box's diagonal) on the same hulls (not a proof)",
+    native=True,
 )
 PLANNERS = {name: PLANNERS[name] for name in PLANNER_NAMES}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
@@ -517,47 +544,13 @@ def plan(
         stop = ob.plannerOrTerminationCondition(
             stop, ob.exactSolnPlannerTerminationCondition(ss.getProblemDefinition())
         )
-    lazy = None
     try:
-        if spec.lazy:  # the path certified after solve(); its time counts as the solve's
-            lazy = solve_lazily(
-                ss, validator, setup.read, float(time_limit), setup.screen_step, spec.lazy_repair
-            )
-            solve_time, solved = lazy.time, lazy.solved
+        if spec.native:
+            solved_ = _solve_natively(setup, spec, scenario, time_limit, seed, simplify)
         else:
-            try:
-                ss.solve(stop)
-            finally:
-                if recorder is not None:
-                    recorder.finish()
-            if validator is not None:
-                validator.raise_error()
-            solve_time = float(ss.getLastPlanComputationTime())
-            solved = bool(ss.haveExactSolutionPath())
-        simplify_time, states, length, raw_length = 0.0, [], 0.0, 0.0
-        simplify_edges = 0
-        if solved:
-            path = ss.getSolutionPath()
-            raw_length = float(path.length())
-            states = [setup.read(s).tolist() for s in path.getStates()]
-            length = raw_length
-            del path
-            if simplify:
-                t0 = time.perf_counter()
-                before = validator.counters["edges"] if validator is not None else 0
-                ss.simplifySolution(float(time_limit))
-                if validator is not None:  # every edge the simplifier made was certified
-                    validator.raise_error()
-                    simplify_edges = validator.counters["edges"] - before
-                path = ss.getSolutionPath()
-                # OMPL's simplifier returns a path whose last check and repair failed with
-                # only a warning ("may slightly touch on an invalid region"): keep the
-                # simplified path only when every state and edge of it passes the checker
-                if path.check():
-                    states = [setup.read(s).tolist() for s in path.getStates()]
-                    length = float(path.length())
-                del path
-                simplify_time = time.perf_counter() - t0
+            solved_ = _solve_in_ompl(setup, spec, stop, recorder, time_limit, simplify)
+        solved, solve_time, simplify_time = solved_.solved, solved_.time, solved_.simplify_time
+        states, length, raw_length = solved_.states, solved_.length, solved_.raw_length
         queries = setup.world.counters
         counters = {
             **queries,
@@ -566,11 +559,8 @@ def plan(
         }
         if validator is not None:
             counters |= {f"kc_{k}": v for k, v in validator.counters.items()}
-            counters["kc_simplify_edges"] = simplify_edges
-        if lazy is not None:
-            counters["kc_lazy_attempts"] = lazy.attempts
-            counters["kc_lazy_rejected_paths"] = lazy.rejected_paths
-            counters["kc_lazy_repaired_edges"] = lazy.repaired_edges
+            counters["kc_simplify_edges"] = solved_.simplify_edges
+        counters |= solved_.counters
         timed = None  # after the counters: they are the planner's
         if solved and trajectory:
             timed = setup.timed(states, velocity_limits, acceleration_limits)
@@ -598,6 +588,90 @@ def plan(
         timing={**sensed_times(scenario.obstacles), "build": built, "plan": solve_time,
                 "simplify": simplify_time},
     )
+
+
+@dataclass(frozen=True)
+class _Solved:
+    """What a solve and its simplification gave :func:`plan` (times in seconds)."""
+
+    solved: bool
+    time: float
+    simplify_time: float = 0.0
+    states: list = field(default_factory=list)
+    length: float = 0.0
+    raw_length: float = 0.0
+    simplify_edges: int = 0
+    counters: dict = field(default_factory=dict)
+
+
+def _solve_in_ompl(setup, spec: PlannerSpec, stop, recorder, time_limit: float,
+                   simplify: bool) -> _Solved:  # fmt: skip
+    """Solve ``setup.ss`` with its OMPL planner (lazily when ``spec.lazy``) and simplify
+    the path with OMPL's simplifier, every new edge asked of the same validator."""
+    ss, validator = setup.ss, setup.validator
+    counters = {}
+    if spec.lazy:  # the path certified after solve(); its time counts as the solve's
+        lazy = solve_lazily(
+            ss, validator, setup.read, float(time_limit), setup.screen_step, spec.lazy_repair
+        )
+        solve_time, solved = lazy.time, lazy.solved
+        counters = {"kc_lazy_attempts": lazy.attempts,
+                    "kc_lazy_rejected_paths": lazy.rejected_paths,
+                    "kc_lazy_repaired_edges": lazy.repaired_edges}  # fmt: skip
+    else:
+        try:
+            ss.solve(stop)
+        finally:
+            if recorder is not None:
+                recorder.finish()
+        if validator is not None:
+            validator.raise_error()
+        solve_time = float(ss.getLastPlanComputationTime())
+        solved = bool(ss.haveExactSolutionPath())
+    if not solved:
+        return _Solved(False, solve_time, counters=counters)
+    path = ss.getSolutionPath()
+    raw_length = length = float(path.length())
+    states = [setup.read(s).tolist() for s in path.getStates()]
+    del path
+    simplify_time, simplify_edges = 0.0, 0
+    if simplify:
+        t0 = time.perf_counter()
+        before = validator.counters["edges"] if validator is not None else 0
+        ss.simplifySolution(float(time_limit))
+        if validator is not None:  # every edge the simplifier made was certified
+            validator.raise_error()
+            simplify_edges = validator.counters["edges"] - before
+        path = ss.getSolutionPath()
+        # OMPL's simplifier returns a path whose last check and repair failed with only a
+        # warning ("may slightly touch on an invalid region"): keep the simplified path
+        # only when every state and edge of it passes the checker
+        if path.check():
+            states = [setup.read(s).tolist() for s in path.getStates()]
+            length = float(path.length())
+        del path
+        simplify_time = time.perf_counter() - t0
+    return _Solved(True, solve_time, simplify_time, states, length, raw_length, simplify_edges,
+                   counters)  # fmt: skip
+
+
+def _solve_natively(setup, spec: PlannerSpec, scenario, time_limit: float, seed,
+                    simplify: bool) -> _Solved:  # fmt: skip
+    """Solve with the compiled RRT-Connect (:mod:`kcplan.planning.native`)."""
+    native = solve_natively(setup, spec, scenario.start, scenario.goal, time_limit, seed, simplify)
+    if native.solved and spec.kc:
+        setup.validator.raise_error()
+    return _Solved(
+        native.solved, native.time, native.simplify_time, native.states,
+        _joint_length(native.states), _joint_length(native.raw_states),
+        native.counters["native_shortcut_edges"], native.counters,
+    )  # fmt: skip
+
+
+def _joint_length(states: list) -> float:
+    """A path's length as OMPL measures a joint-space path: the L2 norms of its steps."""
+    q = np.asarray(states, dtype=float)
+    return float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum()) if len(q) > 1 else 0.0
 
 
 def sensed_times(obstacles) -> dict[str, float]:
