@@ -11,7 +11,6 @@ from conftest import arm_obstacles, panda_arm
 
 from kcplan import _kernel
 from kcplan.arm import ArmWorld
-from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION
 from kcplan.planning.kernel import KernelArmCertifier
 from kcplan.planning.problem import plan

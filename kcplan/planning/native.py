@@ -115,4 +115,3 @@ def solve_natively(
         counters["native_checked_states"] = discrete.states
     return NativeOutcome(plan.solved, plan.solve_seconds, plan.simplify_seconds, path, raw,
                          counters)  # fmt: skip
-

@@ -23,7 +23,6 @@ from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.lazy import solve_lazily
-from kcplan.planning.native import solve_natively
 from kcplan.planning.names import (
     CERTIFIABLE,
     JOINT_STEP,
@@ -34,6 +33,7 @@ from kcplan.planning.names import (
     check_planner_name,
     default_planner,
 )
+from kcplan.planning.native import solve_natively
 from kcplan.planning.progress import ProgressRecorder, reports_progress
 from kcplan.planning.setups import setup_for
 from kcplan.planning.verify import PathCheck, verify_path
@@ -585,8 +585,12 @@ def plan(
         setup.backend,
         setup.joints,
         trajectory=timed,
-        timing={**sensed_times(scenario.obstacles), "build": built, "plan": solve_time,
-                "simplify": simplify_time},
+        timing={
+            **sensed_times(scenario.obstacles),
+            "build": built,
+            "plan": solve_time,
+            "simplify": simplify_time,
+        },
     )
 
 
