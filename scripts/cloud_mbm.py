@@ -20,7 +20,7 @@ of ``--robot`` (``panda``, default, or ``ur5``; read by :mod:`kcplan.arm.mbm`):
    ``--point-radius`` (default 0.0025 m, VAMP's ``POINT_RADIUS``), no filter, since
    kcplan's proof is about the original points. The obstacle is
    ``Obstacle(kind="pointcloud", ...)`` in place of the scenario's primitives, and
-   :func:`kcplan.plan` (its default arm planner, ``kc-rrtconnect-lazy``, ``--time``
+   :func:`kcplan.plan` (``--planner``, default kcplan's default arm planner; ``--time``
    seconds) is timed whole: ``plan`` is ``PlanResult.time`` (solve), ``simplify`` its
    ``simplify_time``, and ``build`` the rest of the call (the collision world with the
    cloud's compiled tree, the validator, OMPL's setup; not the self pairs proven apart
@@ -274,7 +274,7 @@ def _timed_plan(scenario, args: argparse.Namespace) -> dict:
 
     t0 = time.perf_counter()
     try:
-        result = plan(scenario, seed=args.seed, time_limit=args.time)
+        result = plan(scenario, args.planner, seed=args.seed, time_limit=args.time)
     except Exception as err:  # noqa: BLE001 - reported, not fatal (e.g. start in contact)
         return {"solved": False, "error": f"{type(err).__name__}: {err}"}
     wall = time.perf_counter() - t0
@@ -662,6 +662,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="VAMP's filter: least distance of kept points (m)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=1, help="clouds and OMPL's seed")
     parser.add_argument("--time", type=float, default=10.0, help="kcplan's time limit (s)")
+    parser.add_argument("--planner", default=None,
+                        help="kcplan's planner (default: its default for arms)")
     parser.add_argument("--calls", type=int, default=5, help="VAMP runs per problem (median)")
     parser.add_argument("--verify-budget", type=float, default=600.0,
                         help="seconds per path and scene to check it (0: no limit)")  # fmt: skip

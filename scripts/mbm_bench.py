@@ -20,7 +20,7 @@ For the first ``--per-class`` problems of each class of a robot's ``problems.tar
 
 It prints (and writes to ``DIR/mbm_table.md``) one Markdown table: per class, the
 problems, how many are invalid for the cover, and per planner solved / planned, the
-median time in seconds over the planned problems (an unsolved one counts at the time
+median time in milliseconds over the planned problems (an unsolved one counts at the time
 limit, so a planner cannot look fast by failing) and how many returned paths collide on
 the meshes; VAMP's columns are over all the class's problems, its time VAMP's own
 planning time in milliseconds::
@@ -130,7 +130,7 @@ def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dic
     planners = args.planners.split(",")
     head = ["class", "problems", "invalid for the cover"]
     for planner in planners:
-        head += [f"{planner} solved", "median s", "colliding"]
+        head += [f"{planner} solved", "median ms", "colliding"]
     if vamp:
         head += ["VAMP solved", "median ms", "colliding"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -143,7 +143,7 @@ def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dic
         for planner in planners:
             mine = [r for c in classes for r in by_class[c] if r["planner"] == planner]
             solved = sum(int(r["solved"]) for r in mine)
-            times = [float(r["median_time"]) for r in mine]
+            times = [1e3 * float(r["median_time"]) for r in mine]
             colliding = sum(int(r["colliding_paths"]) for r in mine)
             cells += [f"{solved} / {len(mine)}", _median(times), str(colliding)]
         if vamp:
@@ -157,7 +157,7 @@ def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dic
     return lines
 
 
-def _median(values: list[float], digits: int = 3) -> str:
+def _median(values: list[float], digits: int = 2) -> str:
     return f"{statistics.median(values):.{digits}f}" if values else "-"
 
 

@@ -407,9 +407,9 @@ CASES.append(
     Case(  # the default representation (the links' hulls), as the bundled scenarios'
         "mbm_bench.py",
         ("--per-class", "1", "--classes", "table_pick")
-        + ("--planners", "kc-rrtconnect,rrtconnect", "--time", "2", "-o", "{tmp}"),
+        + ("--planners", "kc-rrtconnect-native,rrtconnect", "--time", "2", "-o", "{tmp}"),
         (
-            r"^\| class \| problems \| invalid for the cover \| kc-rrtconnect solved \| ",
+            r"^\| class \| problems \| invalid for the cover \| kc-rrtconnect-native solved \| ",
             rf"^\| table_pick \| 1 \| 0 \| 1 / 1 \| {NUMBER} \| 0 \| 1 / 1 \| {NUMBER} \| 0 \|$",
             rf"^\| all \| 1 \| 0 \| 1 / 1 \| {NUMBER} \| 0 \| 1 / 1 \| {NUMBER} \| 0 \|$",
         ),

@@ -191,14 +191,12 @@ def add_obstacles(world: _core.World, obstacles, n: int) -> None:
 
 def kernel_chain(arm) -> _core.Chain:
     """The kernel's twin of an :class:`kcplan.arm.ArmModel`'s chain and bodies: the
-    reduced model's joint placements, axes and kinds (:func:`kcplan.arm.kinematics.
-    joint_axes`), each joint's place in the state, the limits and the bodies (a hull's
-    vertices and triangles with it)."""
-    from kcplan.arm.kinematics import joint_axes  # here: rigid users never load Pinocchio
-
+    reduced model's joint placements, axes and kinds (``arm.joint_axes()``), each joint's
+    place in the state, the limits and the bodies (a hull's vertices and triangles with
+    it). The kernel imports nothing of kcplan's above it: the arm is read, not imported."""
     model = arm.model
     state_of = {int(i): j for j, i in enumerate(arm.q_index)}
-    axes = joint_axes(arm)
+    axes = arm.joint_axes()
     parents, placements, axis, prismatic, states = [], [], [], [], []
     for i in range(1, model.njoints):
         parents.append(int(model.parents[i]))

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from kcplan.arm.bounds import speeds
 from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull
-from kcplan.arm.kinematics import JOINT_KINDS, body_frames
+from kcplan.arm.kinematics import JOINT_KINDS, body_frames, joint_axes
 from kcplan.arm.shapes import bvh_mesh
 from kcplan.cover.cache import cached_cover
 from kcplan.cover.fit import Cover
@@ -218,6 +218,11 @@ class ArmModel(RobotModel):
         """World frames of the bodies, shape ``(len(bodies), 4, 4)``
         (:func:`kcplan.arm.kinematics.body_frames`)."""
         return body_frames(self, state)
+
+    def joint_axes(self) -> NDArray[np.float64]:
+        """Unit axis of every joint of the reduced model in its own frame, shape
+        ``(njoints, 3)`` (:func:`kcplan.arm.kinematics.joint_axes`)."""
+        return joint_axes(self)
 
     def edge_state(
         self, state1: Sequence[float], state2: Sequence[float], s: float
