@@ -31,9 +31,52 @@ ArmRRTConnect::ArmRRTConnect(const Chain& chain, ArmMotionValidator& tree,
     throw std::invalid_argument("lazy planner: expected a certifying path validator");
 }
 
+void ArmRRTConnect::Tree::reset(const double* root, int n) {
+  states.assign(root, root + n);
+  parents = {-1}, below = {-1}, above = {-1}, depth = {0};
+}
+
+void ArmRRTConnect::Tree::add(const double* q, int parent, int n, bool kd_tree) {
+  const int index = static_cast<int>(parents.size());
+  states.insert(states.end(), q, q + n);
+  parents.push_back(parent), below.push_back(-1), above.push_back(-1), depth.push_back(0);
+  if (!kd_tree) return;
+  for (int node = 0;;) {
+    const int j = depth[node] % n;
+    int& child = q[j] < states[static_cast<std::size_t>(node) * n + j] ? below[node] : above[node];
+    if (child < 0) {
+      child = index, depth[index] = depth[node] + 1;
+      return;
+    }
+    node = child;
+  }
+}
+
+void ArmRRTConnect::nearest_in(const Tree& tree, int node, const double* q, std::size_t& best,
+                               double& least) const {
+  while (node >= 0) {
+    const double* s = tree.states.data() + static_cast<std::size_t>(node) * n_;
+    double d = 0.0;
+    for (int j = 0; j < n_; ++j) d += (s[j] - q[j]) * (s[j] - q[j]);
+    if (d < least) least = d, best = static_cast<std::size_t>(node);
+    const int j = tree.depth[node] % n_;
+    const double across = q[j] - s[j];
+    const int near = across < 0.0 ? tree.below[node] : tree.above[node];
+    const int far = across < 0.0 ? tree.above[node] : tree.below[node];
+    nearest_in(tree, near, q, best, least);
+    // the far side holds only states at least |across| away along joint j
+    if (far < 0 || across * across >= least) return;
+    node = far;
+  }
+}
+
 std::size_t ArmRRTConnect::nearest(const Tree& tree, const double* q) const {
   std::size_t best = 0;
   double least = std::numeric_limits<double>::infinity();
+  if (kd_tree_) {
+    nearest_in(tree, 0, q, best, least);
+    return best;
+  }
   const std::size_t count = tree.parents.size();
   for (std::size_t i = 0; i < count; ++i) {
     const double* s = tree.states.data() + i * n_;
@@ -58,8 +101,7 @@ ArmRRTConnect::Grown ArmRRTConnect::grow(Tree& tree, const double* target,
   for (int j = 0; j < n_; ++j) step_[j] = reach ? target[j] : from[j] + t * (target[j] - from[j]);
   ++plan.tree_edges;
   if (!edges.check(from, step_.data())) return Grown::kTrapped;
-  tree.states.insert(tree.states.end(), step_.begin(), step_.end());
-  tree.parents.push_back(static_cast<int>(near));
+  tree.add(step_.data(), static_cast<int>(near), n_, kd_tree_);
   last_ = tree.parents.size() - 1;
   return reach ? Grown::kReached : Grown::kAdvanced;
 }
@@ -69,8 +111,8 @@ std::vector<double> ArmRRTConnect::search(const double* start, const double* goa
                                           ArmPlan& plan) {
   const auto t0 = Clock::now();
   Tree trees[2];
-  trees[0].states.assign(start, start + n_), trees[0].parents = {-1};
-  trees[1].states.assign(goal, goal + n_), trees[1].parents = {-1};
+  trees[0].reset(start, n_);
+  trees[1].reset(goal, n_);
   const std::vector<double>& lower = chain_.lower();
   const std::vector<double>& upper = chain_.upper();
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -187,6 +229,7 @@ ArmPlan ArmRRTConnect::solve(const double* start, const double* goal,
   if (!(options.time_limit > 0.0))
     throw std::invalid_argument("time limit: expected a number > 0");
   range_ = options.range;
+  kd_tree_ = options.kd_tree;
   rng_.seed(options.seed);
   ArmPlan plan;
   const auto t0 = Clock::now();

@@ -18,6 +18,9 @@ struct ArmPlannerOptions {
   double time_limit = 10.0; ///< seconds for the search (the shortcuts have as many again)
   std::uint64_t seed = 0;   ///< the sampler's seed: the same seed, the same path
   bool simplify = true;     ///< shortcut the path (ArmRRTConnect::shortcut)
+  /// Nearest neighbours by a k-d tree grown with the tree (true), or by a linear scan
+  /// (false, the ablation); the same neighbour either way, up to ties.
+  bool kd_tree = true;
   /// Lazy (with a path validator): seconds the repairs of one path may take, as a
   /// multiple of what the attempt that found it took.
   double repair_share = 1.0;
@@ -42,8 +45,8 @@ struct ArmPlan {
 /// joint box, edges decided by validators.
 ///
 /// Two trees grow from the start and the goal: a uniform sample in the box, the nearest
-/// state of one tree (L2 in joint space, a linear scan: trees here hold tens to a few
-/// thousand states), a step of at most `range` towards the sample, kept when
+/// state of one tree (L2 in joint space: a k-d tree that splits on the joints in turn,
+/// grown as the tree is, searched exactly with the usual pruning; or a linear scan), a step of at most `range` towards the sample, kept when
 /// `tree.check(nearest, new)` holds; then the other tree extends towards the new state
 /// until it reaches it (a path) or is stopped; the trees swap. As OMPL's, every tree edge
 /// is checked from the tree's state to the new one (check()'s q1 is always a valid state).
@@ -75,6 +78,12 @@ class ArmRRTConnect {
   struct Tree {
     std::vector<double> states;  // dof() each
     std::vector<int> parents;    // -1 at the root
+    // the k-d tree over the states: state i's children (-1: none); it splits on joint
+    // depth % dof() at its own value
+    std::vector<int> below, above;
+    std::vector<int> depth;
+    void reset(const double* root, int n);
+    void add(const double* q, int parent, int n, bool kd_tree);
   };
   enum class Grown { kTrapped, kAdvanced, kReached };
 
@@ -84,6 +93,8 @@ class ArmRRTConnect {
                              ArmMotionValidator& edges, double deadline, ArmPlan& plan);
   Grown grow(Tree& tree, const double* target, ArmMotionValidator& edges, ArmPlan& plan);
   std::size_t nearest(const Tree& tree, const double* q) const;
+  void nearest_in(const Tree& tree, int node, const double* q, std::size_t& best,
+                  double& least) const;
   /// The lazy planner's path checked edge by edge by `path_`, rejected edges repaired;
   /// false when a repair failed.
   bool certify(std::vector<double>& path, double budget, ArmPlan& plan);
@@ -95,6 +106,7 @@ class ArmRRTConnect {
   ArmMotionValidator* path_;
   int n_;
   double range_ = 0.5;
+  bool kd_tree_ = true;
   std::mt19937_64 rng_;
   std::vector<double> sample_, step_;
   std::size_t last_ = 0;  // grow(): the index of the state that reached or advanced

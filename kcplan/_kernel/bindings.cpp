@@ -581,15 +581,15 @@ NB_MODULE(_core, m) {
            nb::keep_alive<1, 3>(), nb::keep_alive<1, 4>())
       .def("solve", [](kcplan::ArmRRTConnect& p, const std::vector<double>& start, const std::vector<double>& goal,
                        double range, double time_limit, std::uint64_t seed, bool simplify,
-                       double repair_share) {
+                       double repair_share, bool kd_tree) {
         const kcplan::Chain& chain = p.chain();
         kcplan::ArmPlannerOptions o;
         o.range = range, o.time_limit = time_limit, o.seed = seed, o.simplify = simplify;
-        o.repair_share = repair_share;
+        o.repair_share = repair_share, o.kd_tree = kd_tree;
         kcplan::ArmPlan plan = p.solve(joints_of(chain, start), joints_of(chain, goal), o);
         return nb::make_tuple(plan, rows_of(plan.path, chain.dof()),
                               rows_of(plan.raw_path, chain.dof()));
       }, "start"_a, "goal"_a, "range"_a, "time_limit"_a, "seed"_a = 0,
-      "simplify"_a = true, "repair_share"_a = 1.0,
+      "simplify"_a = true, "repair_share"_a = 1.0, "kd_tree"_a = true,
       "(ArmPlan, path rows, raw path rows) of one search from start to goal");
 }

@@ -3,7 +3,8 @@
 :mod:`.guard`, :mod:`.certificates`, :mod:`.certifier`, :mod:`.ladder` and :mod:`.verify`
 do not import OMPL; :mod:`.validator`, :mod:`.states`, :mod:`.setups` (what each robot
 kind puts into OMPL) and :mod:`.problem` (:func:`~.problem.plan`, the same for every
-kind) are the thin OMPL adapters.
+kind) are the thin OMPL adapters. :mod:`.native` runs an arm's planning loop in the
+compiled kernel instead (``kc-rrtconnect-native``), with no OMPL or Python per edge.
 """
 
 from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
