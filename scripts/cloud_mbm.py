@@ -593,7 +593,8 @@ def table(rows: list[dict], vamp: dict | None, robot: str) -> tuple[list[str], d
         head += ["VAMP kept", "VAMP filter", "VAMP build", "VAMP plan", "VAMP simplify",
                  "VAMP total"]  # fmt: skip
     head += ["colliding vs cloud kc / VAMP", "colliding vs primitives kc / VAMP"]
-    lines = [f"**{robot}**: kcplan (kc-rrtconnect-lazy) on the raw cloud vs VAMP-CAPT "
+    planners = sorted({r["kc_cloud"].get("planner", "?") for r in rows if "kc_cloud" in r})
+    lines = [f"**{robot}**: kcplan ({', '.join(planners)}) on the raw cloud vs VAMP-CAPT "
              "(filtered); times in ms, medians over the solved problems", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]  # fmt: skip
 

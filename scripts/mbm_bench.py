@@ -11,7 +11,8 @@ For the first ``--per-class`` problems of each class of a robot's ``problems.tar
    counted as *invalid for the cover* and not planned: no planner on that cover can
    solve it;
 2. ``kcplan bench`` runs every ``--planners`` on the others, one run each (seed
-   ``--seed``), ``--time`` seconds, no simplification, into ``DIR/bench`` (its OMPL
+   ``--seed``), ``--time`` seconds, no simplification (``--simplify``: with it, and its
+   median milliseconds and the median path length in the table), into ``DIR/bench`` (its OMPL
    logs, ``results.db`` and ``summary.csv``; every path verified without gaps on the
    links' own collision meshes);
 3. with ``--vamp-python`` (a Python with VAMP, ``bash ../shared/tools/vamp/build-vamp.sh
@@ -27,7 +28,8 @@ planning time in milliseconds::
 
     python scripts/mbm_bench.py [--robot panda|ur5] [--per-class 20] [--classes box,cage]
         [--planners kc-rrtconnect,rrtconnect,...] [--time 10] [--representation R]
-        [--bodies-per-link K] [--max-offset D] [--jobs J] [--vamp-python PY] [-o DIR]
+        [--bodies-per-link K] [--max-offset D] [--jobs J] [--simplify] [--vamp-python PY]
+        [-o DIR]
 
 A shared, loaded machine makes the times indicative; the counts are what they are.
 """
@@ -104,7 +106,8 @@ def run_bench(args: argparse.Namespace, files: list[Path], folder: Path) -> list
     """Step 2: ``kcplan bench`` on ``files``; the rows of its ``summary.csv``."""
     command = [sys.executable, "-m", "kcplan.cli", "bench", *map(os.fspath, files),
                "--planners", args.planners, "--runs", "1", "--seed", str(args.seed),
-               "--time", str(args.time), "--no-simplify", "--progress-interval", "0",
+               "--time", str(args.time), *(() if args.simplify else ("--no-simplify",)),
+               "--progress-interval", "0",
                "--jobs", str(args.jobs),
                "-o", os.fspath(folder), "--force"]  # fmt: skip
     subprocess.run(command, check=True, cwd=ROOT)
@@ -131,6 +134,8 @@ def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dic
     head = ["class", "problems", "invalid for the cover"]
     for planner in planners:
         head += [f"{planner} solved", "median ms", "colliding"]
+        if args.simplify:
+            head += ["simplify ms", "length"]
     if vamp:
         head += ["VAMP solved", "median ms", "colliding"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -146,6 +151,10 @@ def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dic
             times = [1e3 * float(r["median_time"]) for r in mine]
             colliding = sum(int(r["colliding_paths"]) for r in mine)
             cells += [f"{solved} / {len(mine)}", _median(times), str(colliding)]
+            if args.simplify:
+                done = [r for r in mine if int(r["solved"])]
+                cells += [_median([1e3 * float(r["median_simplify_time"]) for r in done]),
+                          _median([float(r["median_length"]) for r in done])]  # fmt: skip
         if vamp:
             mine = [v for (c, _), v in vamp.items() if c in classes]
             solved = [r for r, _ in mine if r["solved"]]
@@ -171,6 +180,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--time", type=float, default=10.0, help="seconds per solve")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--jobs", type=int, default=1, help="runs at once (kcplan bench)")
+    parser.add_argument("--simplify", action="store_true",
+                        help="simplify the paths too, and show its median ms and the length")
     parser.add_argument(
         "--representation",
         choices=("hulls", "ellipsoids"),

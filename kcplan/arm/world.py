@@ -115,8 +115,6 @@ class ArmWorld:
         self.self_pairs = pairs
         """The pairs of :attr:`ArmModel.self_pairs` whose links are not allowed to touch
         and that are not proven apart."""
-        self._shapes = [_fcl_shape(b) for b in arm.bodies]
-        self._bodies = [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
         for ob in self.obstacles:
             if len(ob.center) != 3:
                 raise ValueError(f"{ob.label}: expected a 3D obstacle for an arm")
@@ -137,6 +135,16 @@ class ArmWorld:
         self._fcl_counters = {"collision_queries": 0, "distance_queries": 0}
         self._request = fcl.DistanceRequest(enable_nearest_points=True)
         self._kernel = None
+
+    @cached_property
+    def _shapes(self) -> list:
+        """The bodies' FCL shapes, made on first use (a planner on the kernel never asks)."""
+        return [_fcl_shape(b) for b in self.arm.bodies]
+
+    @cached_property
+    def _bodies(self) -> list:
+        """The bodies' FCL objects, placed by each query."""
+        return [fcl.CollisionObject(shape, fcl.Transform()) for shape in self._shapes]
 
     @cached_property
     def _scene(self) -> tuple:

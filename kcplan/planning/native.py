@@ -65,6 +65,7 @@ def solve_natively(
     time_limit: float,
     seed: int | None,
     simplify: bool,
+    kd_tree: bool = True,
 ) -> NativeOutcome:
     """Plan ``setup``'s arm from ``start`` to ``goal`` with the compiled RRT-Connect.
 
@@ -85,6 +86,9 @@ def solve_natively(
         The sampler's seed; None draws one.
     simplify : bool
         Shortcut the path (greedy, then random pairs of points; kcplan/_kernel/arm_planner.hpp).
+    kd_tree : bool
+        Nearest neighbours by a k-d tree; False: a linear scan (the ablation, the same
+        neighbours).
     """
     world = setup.world.kernel
     extent = float(setup.space.getMaximumExtent())
@@ -104,7 +108,7 @@ def solve_natively(
     seed = secrets.randbits(63) if seed is None else int(seed)
     plan, path, raw = planner.solve(
         [float(v) for v in start], [float(v) for v in goal], setup.kc_range * extent,
-        float(time_limit), seed, bool(simplify), REPAIR_SHARE,
+        float(time_limit), seed, bool(simplify), REPAIR_SHARE, bool(kd_tree),
     )  # fmt: skip
     counters = {
         f"native_{name}": getattr(plan, name)

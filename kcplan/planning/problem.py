@@ -79,6 +79,7 @@ class PlannerSpec:
     lazy: bool = False  # kc: screen the trees' edges, certify the path (planning.lazy)
     lazy_repair: bool = True  # lazy: a rejected edge replaced by a certified sub-plan
     native: bool = False  # arms: the compiled RRT-Connect (planning.native), not OMPL's
+    kd_tree: bool = True  # native: nearest neighbours by a k-d tree (False: a linear scan)
 
     @property
     def kc(self) -> bool:
@@ -294,6 +295,12 @@ PLANNERS["kc-rrtconnect-lazy-native"] = replace(
     "the path it returns, a rejected edge repaired by a certified sub-plan",
     native=True,
 )
+PLANNERS["kc-rrtconnect-lazy-native-scan"] = replace(
+    PLANNERS["kc-rrtconnect-lazy-native"],
+    description="ablation: kc-rrtconnect-lazy-native finding nearest neighbours by a linear "
+    "scan, not its k-d tree (the same neighbours)",
+    kd_tree=False,
+)
 PLANNERS["rrtconnect-32-native"] = replace(
     PLANNERS["rrtconnect-32"],
     description="arms only: the compiled RRT-Connect of kc-rrtconnect-native checking states "
@@ -435,7 +442,7 @@ def plan(
     planner : str, optional
         A key of :data:`PLANNERS`; default
         :func:`~kcplan.planning.names.default_planner` of the robot's kind
-        (``kc-rrtconnect``, and ``kc-rrtconnect-lazy`` for an arm).
+        (``kc-rrtconnect``, and ``kc-rrtconnect-lazy-native`` for an arm).
     time_limit : float
         Seconds for ``solve()``; simplification has its own budget of the same length.
     seed : int, optional
@@ -662,7 +669,8 @@ def _solve_in_ompl(setup, spec: PlannerSpec, stop, recorder, time_limit: float,
 def _solve_natively(setup, spec: PlannerSpec, scenario, time_limit: float, seed,
                     simplify: bool) -> _Solved:  # fmt: skip
     """Solve with the compiled RRT-Connect (:mod:`kcplan.planning.native`)."""
-    native = solve_natively(setup, spec, scenario.start, scenario.goal, time_limit, seed, simplify)
+    native = solve_natively(setup, spec, scenario.start, scenario.goal, time_limit, seed, simplify,
+                            spec.kd_tree)  # fmt: skip
     if native.solved and spec.kc:
         setup.validator.raise_error()
     return _Solved(
