@@ -1,4 +1,5 @@
-"""Shared hypothesis strategies for the geometry tests, and a private cover cache."""
+"""Shared hypothesis strategies for the geometry tests, a private cover cache, and the
+suite's time budget per test file."""
 
 import os
 import tempfile
@@ -21,6 +22,35 @@ if _RUN:
     os.environ["KCPLAN_CACHE_DIR"] = str(_CACHE)
 else:
     os.environ["KCPLAN_CACHE_DIR"] = tempfile.mkdtemp(prefix="kcplan-test-cache-")
+
+FILE_BUDGET = 60.0
+"""Seconds a test file's tests may take together (setup, call and teardown, summed over
+workers) before the summary names it: with two workers the ten-minute suite holds about
+twenty such files, so a file past it is where a new test should get smaller or become a
+study (``@pytest.mark.study``, run apart by ``pytest -m study``)."""
+FILE_BUDGETS = {"test_scripts.py": 240.0}
+"""Files allowed more: every script in ``scripts/`` runs once, at its smallest arguments."""
+_FILE_SECONDS: dict[str, float] = {}
+
+
+def pytest_runtest_logreport(report):
+    path = report.nodeid.split("::", 1)[0]
+    _FILE_SECONDS[path] = _FILE_SECONDS.get(path, 0.0) + report.duration
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The files past their budget (:data:`FILE_BUDGET`), and the five slowest files."""
+    if not _FILE_SECONDS:
+        return
+    ranked = sorted(_FILE_SECONDS.items(), key=lambda item: -item[1])
+    over = [(p, t) for p, t in ranked if t > FILE_BUDGETS.get(Path(p).name, FILE_BUDGET)]
+    terminalreporter.section("time per test file")
+    for path, seconds in ranked[:5]:
+        terminalreporter.write_line(f"{seconds:7.1f} s  {path}")
+    terminalreporter.write_line(f"{sum(_FILE_SECONDS.values()):7.1f} s  in all (every worker)")
+    for path, seconds in over:
+        budget = FILE_BUDGETS.get(Path(path).name, FILE_BUDGET)
+        terminalreporter.write_line(f"over budget: {path}: {seconds:.1f} s (budget {budget:.0f} s)")
 
 
 @st.composite

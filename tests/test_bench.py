@@ -308,6 +308,7 @@ def _content(records):
     )
 
 
+@pytest.mark.study  # a Dask cluster's start-up: .ci/run runs it (pytest -m study)
 def test_dask_executor_gives_the_same_results_as_local(tmp_path):
     distributed = pytest.importorskip("dask.distributed", reason="dask[distributed] not installed")
     specs = campaign_specs(

@@ -399,6 +399,7 @@ def test_no_sample_of_a_real_part_lies_outside_its_cover(name, bodies):
     _assert_covered(solid, cover, mesh, SAMPLES)
 
 
+@pytest.mark.study  # a slow study: .ci/run runs it (pytest -m study)
 def test_a_torus_and_a_2d_outline_with_a_notch_are_covered(tmp_path):
     torus = trimesh.creation.torus(1.0, 0.3, major_sections=48, minor_sections=16)
     torus.export(tmp_path / "torus.stl")
@@ -469,7 +470,7 @@ def _random_solid_is_covered(tmp_path_factory, seed, bodies, convex):
     _assert_covered(solid, cover, _mesh(path), 20_000, seed)
 
 
-@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.integers(0, 2**31), st.integers(1, 5), st.booleans())
 def test_random_convex_and_star_solids_are_covered(tmp_path_factory, seed, bodies, convex):
     _random_solid_is_covered(tmp_path_factory, seed, bodies, convex)
@@ -500,6 +501,7 @@ def test_random_simple_polygons_are_covered(tmp_path_factory, seed, bodies):
     _assert_covered(solid, fit_cover(solid, bodies=bodies), None, 20_000, seed)
 
 
+@pytest.mark.study  # a slow study: .ci/run runs it (pytest -m study)
 def test_ellipsoids_are_much_tighter_than_spheres_on_the_long_hand(hand):
     """K = 4: the Panda hand's excess volume is almost twice smaller with ellipsoids
     (0.607 against 1.204 at FIT_VERSION 3, whose cuts tighten the spheres most)."""
@@ -1053,6 +1055,7 @@ def test_the_offset_bound_holds_the_exact_offset_of_the_ball_around_a_cube(tmp_p
     assert meter.bound(ball, 0.002, below=0.3).low > 0.3
 
 
+@pytest.mark.study  # a slow study: .ci/run runs it (pytest -m study)
 def test_a_max_offset_fit_sticks_out_at_most_that_far_and_stays_sound(tmp_path):
     """The L bracket (20 triangles, 60 mm) covered to stick out by at most 6 mm: the fit's
     proved bound is within it, so is every one of 400 independent random points per body

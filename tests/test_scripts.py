@@ -77,7 +77,7 @@ def _never_looser(out: str, _tmp: Path) -> None:
 
 
 def _no_violation(out: str, _tmp: Path, names=tuple(CERTIFICATE_SETS)) -> None:
-    rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 100 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
+    rows = re.findall(r"^\| ([23]D) \| ([\w-]+) \| 50 \| (\d+) \| (\d+) \| (\d+) \|$", out, re.M)
     assert {(n, name) for n, name, *_ in rows} == {
         (n, name) for n in ("2D", "3D") for name in names
     }
@@ -341,7 +341,7 @@ CASES = [
     *(
         Case(
             "soundness_study.py",
-            ("--edges", "100", "--backend", backend, *extra),
+            ("--edges", "50", "--backend", backend, *extra),
             (r"\| dimension \| certificates \| edges \|",),
             check=_no_violation,
         )
@@ -353,7 +353,7 @@ CASES = [
     ),
     Case(  # robots of 3 offset bodies: the arc rule; no paper polytope for them
         "soundness_study.py",
-        ("--edges", "100", "--bodies", "3"),
+        ("--edges", "50", "--bodies", "3"),
         (r"\| dimension \| certificates \| edges \|",),
         check=functools.partial(
             _no_violation, names=[k for k, v in CERTIFICATE_SETS.items() if "polytope" not in v]
