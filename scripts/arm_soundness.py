@@ -85,8 +85,8 @@ from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
 from kcplan.arm.verify import ArmMeshChecker
 from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import sample_surface_points, voxel_filter
-from kcplan.world.scenario import Obstacle
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"

@@ -38,7 +38,7 @@ from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
 from kcplan.world import CollisionWorld, Scenario
 from kcplan.world.clutter import random_pose, random_robot, random_scenario
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 SHAPES = {
     2: ([5.0, 3.5], [1.0, 0.4], [3.0, 3.0], [8.0, 1.0]),

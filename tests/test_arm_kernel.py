@@ -27,7 +27,7 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
     "cylinder", 3, {}, np.array([0.45, 0.35, 0.4]),

@@ -17,7 +17,7 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 BODIES_PER_LINK = None  # the links' own hulls (kcplan's default representation)
 READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])

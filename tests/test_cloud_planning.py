@@ -15,8 +15,8 @@ from kcplan import plan
 from kcplan.cli import main
 from kcplan.scenarios import load_scenario
 from kcplan.views.arm import obstacle_mesh
+from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import sample_surface_points
-from kcplan.world.scenario import Obstacle
 
 ROOT = Path(__file__).resolve().parents[1]
 POINT_RADIUS = 0.0025

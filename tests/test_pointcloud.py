@@ -24,7 +24,7 @@ from trimesh.triangles import closest_point
 from kcplan.cli import main
 from kcplan.scenarios import dump_scenario, load_scenario
 from kcplan.world import ScenarioError, scenario_to_dict
-from kcplan.world import scenario as scenario_module
+from kcplan.world import obstacles as obstacles_module
 from kcplan.world.pointcloud import (
     CloudInfo,
     PointCloudError,
@@ -591,7 +591,7 @@ def test_a_2d_scenario_refuses_clouds(tmp_path, kind):
 
 
 def test_too_many_points_are_refused(tmp_path, monkeypatch):
-    monkeypatch.setattr(scenario_module, "MAX_CLOUD_POINTS", 20)
+    monkeypatch.setattr(obstacles_module, "MAX_CLOUD_POINTS", 20)
     np.save(tmp_path / "c.npy", POINTS)
     path = _rigid(tmp_path, [{"pointcloud": {"file": "c.npy", "point_radius": 0.1}}])
     with pytest.raises(ScenarioError) as err:

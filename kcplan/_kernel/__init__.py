@@ -161,7 +161,7 @@ def build_kernel_world(scenario, robot, half_height: float) -> _core.World:
 
 
 def add_obstacles(world: _core.World, obstacles, n: int) -> None:
-    """Add :class:`kcplan.world.scenario.Obstacle` s of an ``n``-D scene to a kernel world
+    """Add :class:`kcplan.world.obstacles.Obstacle` s of an ``n``-D scene to a kernel world
     (before its first query)."""
     for ob in obstacles:
         centre = [float(v) for v in ob.center] + [0.0] * (3 - n)

@@ -24,7 +24,7 @@ import numpy as np
 
 from kcplan.arm.model import ArmBody, ArmError, ArmModel, hull_bodies, self_pairs_of
 from kcplan.arm.shapes import coal_obstacle
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 __all__ = ["Attached", "attach", "detach"]
 

@@ -11,7 +11,7 @@ A problem is two YAML files (``sceneNNNN.yaml``, ``requestNNNN.yaml``; see
   ``goal_constraints[0].joint_constraints`` (one goal configuration of the planning
   group, whose joints are the goal's, in the order given).
 
-Obstacles come back as :class:`kcplan.world.scenario.Obstacle` (kinds ``box``,
+Obstacles come back as :class:`kcplan.world.obstacles.Obstacle` (kinds ``box``,
 ``sphere`` and ``cylinder``; a cylinder's ``extents`` are ``(r, r, h / 2)``).
 """
 
@@ -29,7 +29,7 @@ import yaml
 
 from kcplan.files import load_yaml
 from kcplan.geometry.pose import quaternion_matrix
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 __all__ = [
     "MBM_CLASSES",

@@ -34,7 +34,7 @@ cylinder's axis is its local z. ``inflation`` is the KC guards' ``eps`` of the `
 planners (each body grown by ``1 + eps`` about its centre,
 :mod:`kcplan.planning.arm_certifier`); 0, the default, takes
 :data:`kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`. Every field is validated with
-the rigid format's one-line errors (:class:`kcplan.world.scenario.ScenarioError`).
+the rigid format's one-line errors (:class:`kcplan.world.fields.ScenarioError`).
 """
 
 from __future__ import annotations
@@ -51,16 +51,9 @@ from kcplan.arm.attach import Attached, attach
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
+from kcplan.world.fields import FieldReader, ScenarioError, read_padding
+from kcplan.world.obstacles import MAX_OBSTACLES, Obstacle, parse_obstacle, self_filtered
 from kcplan.world.pointcloud import ellipsoid_self_filter_mask, hull_self_filter_mask
-from kcplan.world.scenario import (
-    MAX_OBSTACLES,
-    FieldReader,
-    Obstacle,
-    ScenarioError,
-    parse_obstacle,
-    read_padding,
-    self_filtered,
-)
 
 __all__ = ["ArmScenario", "arm_scenario_to_dict", "parse_arm_scenario"]
 

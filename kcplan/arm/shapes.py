@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 __all__ = ["bvh_mesh", "coal_obstacle"]
 

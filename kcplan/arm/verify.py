@@ -30,8 +30,8 @@ from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
 from kcplan.arm.model import ArmModel
 from kcplan.arm.shapes import bvh_mesh
 from kcplan.world.collision import fcl_obstacle_parts
+from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import CLOUD_KINDS
-from kcplan.world.scenario import Obstacle
 
 __all__ = ["ArmMeshChecker", "ArmPathCheck", "verify_arm_path"]
 

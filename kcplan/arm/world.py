@@ -34,8 +34,8 @@ from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import ArmModel
 from kcplan.arm.pairs import prove_pairs as prove_pairs_of
 from kcplan.world.collision import CLEARANCE_ATOL, CLEARANCE_RTOL, fcl_obstacle_parts
+from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import CLOUD_KINDS
-from kcplan.world.scenario import Obstacle
 from kcplan.world.support import EllipsoidSupport, PointsSupport, piece_supports, separation
 
 __all__ = ["ArmWorld", "checked_pairs"]
@@ -67,7 +67,7 @@ class ArmWorld:
     ----------
     arm : ArmModel
     obstacles : sequence of Obstacle
-        3D obstacles (:class:`kcplan.world.scenario.Obstacle`), in the arm's base frame.
+        3D obstacles (:class:`kcplan.world.obstacles.Obstacle`), in the arm's base frame.
     size : float, optional
         Size of the scene in metres, for FCL's absolute error allowance (default: the
         larger of 2 m and the obstacles' extent).

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 from kcplan.arm.model import ArmModel
 from kcplan.arm.shapes import coal_obstacle
 from kcplan.arm.world import checked_pairs
-from kcplan.world.scenario import Obstacle
+from kcplan.world.obstacles import Obstacle
 
 __all__ = ["PinChecker"]
 

@@ -344,7 +344,7 @@ def cylinder_mesh(ob, sections: int = 32) -> tuple[NDArray[np.float64], NDArray[
 
 
 def obstacle_mesh(ob) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """A 3D obstacle (:class:`kcplan.world.scenario.Obstacle`) as one triangle mesh in the
+    """A 3D obstacle (:class:`kcplan.world.obstacles.Obstacle`) as one triangle mesh in the
     world: a box's 12 triangles, a cylinder's (:func:`cylinder_mesh`), a sphere's or an
     ellipsoid's icosphere, a mesh's or a convex obstacle's own triangles. A cloud
     (``pointcloud``, ``depth``) has none: the views draw its points

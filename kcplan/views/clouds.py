@@ -4,7 +4,7 @@ thinned for display, with a label that says how many are drawn.
 Every view (:mod:`kcplan.views.plots`, :mod:`kcplan.views.animation`,
 :mod:`kcplan.views.html`) draws a cloud as points coloured by their height, from
 :func:`cloud_points_for_display`; the thinning is for the picture only (planning uses
-every point of :attr:`kcplan.world.scenario.Obstacle.vertices`). This module imports
+every point of :attr:`kcplan.world.obstacles.Obstacle.vertices`). This module imports
 neither matplotlib nor plotly.
 """
 
@@ -48,7 +48,7 @@ def cloud_points_for_display(ob, limit: int = MAX_DRAWN_POINTS) -> tuple[NDArray
 
     Parameters
     ----------
-    ob : kcplan.world.scenario.Obstacle
+    ob : kcplan.world.obstacles.Obstacle
         Of kind ``pointcloud`` or ``depth``: its ``vertices`` are the points planned with.
     limit : int
         Most points returned: beyond it, ``limit`` of them drawn at random without
@@ -105,7 +105,7 @@ def sensor_triad(ob, size: float | None = None) -> tuple[NDArray[np.float64], ND
 
     Parameters
     ----------
-    ob : kcplan.world.scenario.Obstacle
+    ob : kcplan.world.obstacles.Obstacle
     size : float, optional
         The segments' length; default 0.15 of the cloud's largest extent (at least 4
         planning radii).

@@ -30,7 +30,8 @@ from kcplan.views.clouds import (
 )
 from kcplan.views.plots import body_shapes, ellipse_outline, path_poses
 from kcplan.world.mesh import convex_hull
-from kcplan.world.scenario import Obstacle, Scenario
+from kcplan.world.obstacles import Obstacle
+from kcplan.world.scenario import Scenario
 from kcplan.world.support import box_vertices
 
 __all__ = ["cover_figure", "scene_figure", "write_cover_html", "write_scene_html"]

@@ -158,7 +158,7 @@ def draw_clouds(ax, obstacles, legend: bool = True) -> list:
     Parameters
     ----------
     ax : Axes3D
-    obstacles : sequence of kcplan.world.scenario.Obstacle
+    obstacles : sequence of kcplan.world.obstacles.Obstacle
     legend : bool
         Add a legend naming each cloud and how many of its points are drawn.
 

@@ -38,9 +38,10 @@ from numpy.typing import ArrayLike, NDArray
 from kcplan._kernel import _core, build_kernel_world
 from kcplan.geometry.pose import pose_size, quaternion_multiply, rotate_vector
 from kcplan.geometry.robot import Robot
+from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import CLOUD_KINDS
 from kcplan.world.region import FreeRegion
-from kcplan.world.scenario import Obstacle, Scenario, as_rigid_scenario
+from kcplan.world.scenario import Scenario, as_rigid_scenario
 from kcplan.world.support import EllipsoidSupport, box_vertices, piece_supports, separation
 
 __all__ = [
