@@ -283,35 +283,25 @@ PLANNERS["rrtconnect-pin"] = PlannerSpec(
     "computeCollisions on the same ellipsoid cover (kcplan.planning.pin_checker)",
     backend="pin",
 )
-PLANNERS["kc-rrtconnect-native"] = replace(
-    PLANNERS["kc-rrtconnect"],
-    description="arms only: RRT-Connect compiled beside the certifier (sampling, nearest "
-    "neighbours, extension and shortcuts in C++), every edge certified as kc-rrtconnect's",
-    native=True,
-)
-PLANNERS["kc-rrtconnect-lazy-native"] = replace(
-    PLANNERS["kc-rrtconnect-lazy"],
-    description="arms only: kc-rrtconnect-native screening its trees' edges and certifying "
-    "the path it returns, a rejected edge repaired by a certified sub-plan",
-    native=True,
-)
+for _name, _base, _what in (
+    ("kc-rrtconnect-native", "kc-rrtconnect", "RRT-Connect compiled beside the certifier "
+     "(sampling, nearest neighbours, extension and shortcuts in C++), every edge certified "
+     "as kc-rrtconnect's"),
+    ("kc-rrtconnect-lazy-native", "kc-rrtconnect-lazy", "kc-rrtconnect-native screening its "
+     "trees' edges and certifying the path it returns, a rejected edge repaired by a "
+     "certified sub-plan"),
+    ("rrtconnect-32-native", "rrtconnect-32", "the compiled RRT-Connect of "
+     "kc-rrtconnect-native checking states every 1/32 rad on the same hulls (its stock "
+     "twin; not a proof)"),
+    ("rrtconnect-native", "rrtconnect", "the compiled RRT-Connect checking states at OMPL's "
+     "default resolution (1 % of the joint box's diagonal) on the same hulls (not a proof)"),
+):  # fmt: skip
+    PLANNERS[_name] = replace(PLANNERS[_base], description=f"arms only: {_what}", native=True)
 PLANNERS["kc-rrtconnect-lazy-native-scan"] = replace(
     PLANNERS["kc-rrtconnect-lazy-native"],
     description="ablation: kc-rrtconnect-lazy-native finding nearest neighbours by a linear "
     "scan, not its k-d tree (the same neighbours)",
     kd_tree=False,
-)
-PLANNERS["rrtconnect-32-native"] = replace(
-    PLANNERS["rrtconnect-32"],
-    description="arms only: the compiled RRT-Connect of kc-rrtconnect-native checking states "
-    "every 1/32 rad on the same hulls (its stock twin; not a proof)",
-    native=True,
-)
-PLANNERS["rrtconnect-native"] = replace(
-    PLANNERS["rrtconnect"],
-    description="arms only: the compiled RRT-Connect checking states at OMPL's default "
-    "resolution (1 % of the joint box's diagonal) on the same hulls (not a proof)",
-    native=True,
 )
 PLANNERS = {name: PLANNERS[name] for name in PLANNER_NAMES}
 """Planner names accepted by ``kcplan plan`` and :func:`plan`. Stock planners use OMPL's
