@@ -390,7 +390,7 @@ def held_part(robot: str, shape: str) -> Attached:
             "obstacles": [{shape: PARTS[shape]}]}  # fmt: skip
     if shape == "cylinder":  # the arm scenario's kind: read there
         from kcplan.arm.scenario import _cylinder
-        from kcplan.world.scenario import FieldReader
+        from kcplan.world.fields import FieldReader
 
         part = _cylinder(FieldReader("part"), PARTS[shape], 0)
     else:

@@ -114,7 +114,7 @@ def write_ply(points: np.ndarray, path: Path) -> None:
 def cloud_scenario(source: Path, work: Path, args) -> tuple[Path, dict]:
     """Write ``work/NAME_points.yaml``: ``source`` with its obstacles as one cloud."""
     from kcplan.scenarios import dump_scenario, load_scenario
-    from kcplan.world.scenario import read_scenario_data
+    from kcplan.world.fields import read_scenario_data
 
     scenario = load_scenario(source)
     s_min = smallest_semi_axis(scenario)

@@ -151,7 +151,7 @@ def cloud_obstacle(points, radius: float):
     """The scenario obstacle of a cloud: every point a ball of ``radius``."""
     import numpy as np
 
-    from kcplan.world.scenario import Obstacle
+    from kcplan.world.obstacles import Obstacle
 
     return Obstacle(kind="pointcloud", index=0, spec={}, center=np.zeros(3),
                     rotation=np.eye(3), extents=np.full(3, float(radius)), pieces=(),

@@ -132,7 +132,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = args.output
     from kcplan.scenarios import dump_scenario
-    from kcplan.world.scenario import read_scenario_data
+    from kcplan.world.fields import read_scenario_data
 
     # box_1 as a cloud
     box = load_scenario(SCENARIOS / "arm" / "box_1.yaml")

@@ -24,7 +24,7 @@ from kcplan.arm.scenario import parse_arm_scenario
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.arm_certifier import ArmEdgeCertifier
 from kcplan.planning.kernel import KernelArmCertifier
-from kcplan.world.scenario import ScenarioError
+from kcplan.world.fields import ScenarioError
 
 MARGINS = [1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e100, 1e308]
 """How far outside a joint limit a fuzzed value lies (tiny to huge)."""

@@ -199,7 +199,7 @@ def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
     planes) against the exact distance from the hull to every point, less the radius."""
     from kcplan.arm.kinematics import body_frames
     from kcplan.arm.world import ArmWorld
-    from kcplan.world.scenario import Obstacle
+    from kcplan.world.obstacles import Obstacle
 
     arm = panda
     rng = np.random.default_rng(seed)
