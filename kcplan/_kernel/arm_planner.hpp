@@ -46,8 +46,8 @@ struct ArmPlan {
 ///
 /// Two trees grow from the start and the goal: a uniform sample in the box, the nearest
 /// state of one tree (L2 in joint space: a k-d tree that splits on the joints in turn,
-/// grown as the tree is, searched exactly with the usual pruning; or a linear scan), a step of at most `range` towards the sample, kept when
-/// `tree.check(nearest, new)` holds; then the other tree extends towards the new state
+/// grown as the tree is, searched exactly with the usual pruning; or a linear scan), a
+/// step of at most `range` towards the sample, kept when `tree.check(nearest, new)` holds; then the other tree extends towards the new state
 /// until it reaches it (a path) or is stopped; the trees swap. As OMPL's, every tree edge
 /// is checked from the tree's state to the new one (check()'s q1 is always a valid state).
 ///
@@ -62,7 +62,9 @@ struct ArmPlan {
 /// Shortcuts (simplify) are asked of the final validator: first greedily, from each
 /// state the farthest later state it connects to, then random pairs of points along
 /// the path (OMPL's PathSimplifier::shortcutPath), until as many tries in a row fail as
-/// the path has states. A point between two states lies on a checked edge, so it is valid.
+/// the path has states (at most 4 states + 20 tries), all within time_limit seconds. A
+/// point between two states lies on a checked edge, so it is valid, and a shortcut from
+/// it is checked as any edge; the path never gets longer (triangle inequality).
 ///
 /// Contract: start and goal have dof() finite numbers within the limits (else
 /// std::invalid_argument); the trees' states are within the limits. Not thread-safe.
