@@ -130,6 +130,7 @@ def test_the_u_channel_is_covered_alike_whatever_its_triangulation(tmp_path):
     assert ratios[0] == pytest.approx(ratios[1], rel=0.02)
 
 
+@pytest.mark.study  # a slow study: .ci/run runs it (pytest -m study)
 def test_the_vertices_trees_make_the_ur5_upper_arm_tighter_and_never_looser(monkeypatch):
     """Issue 41, "no mesh worse": cuts at the curvature's quantiles alone left the UR5's
     upper arm at 1.511 times its volume from 4 bodies, where the vertices' quantiles had

@@ -420,7 +420,13 @@ def test_distances_read_off_a_convex_arena_agree_with_python_fcl(tmp_path):
 
 
 @pytest.mark.parametrize("share", [0.25, pytest.param(1.0, marks=pytest.mark.study)])
-@pytest.mark.parametrize("name", sorted(SETS))
+@pytest.mark.parametrize(
+    "name",  # the ablations' agreement a study (.ci/run runs it), kcplan's sets in the suite
+    [
+        pytest.param(k, marks=pytest.mark.study) if k in ("ca", "kc-paper") else k
+        for k in sorted(SETS)
+    ],  # fmt: skip
+)
 def test_kernel_and_python_certifiers_agree_edge_by_edge(name, share):
     """Both certifiers on one CollisionWorld, the same edges in the same order: at least
     99.5 % identical decisions per certificate set, every edge either accepts is free
