@@ -658,11 +658,11 @@ def _solve_in_ompl(setup, spec: PlannerSpec, stop, recorder, time_limit: float,
 
 def _solve_natively(setup, spec: PlannerSpec, scenario, time_limit: float, seed,
                     simplify: bool) -> _Solved:  # fmt: skip
-    """Solve with the compiled RRT-Connect (:mod:`kcplan.planning.native`)."""
+    """Solve with the compiled RRT-Connect (:mod:`kcplan.planning.native`). Its edges never
+    pass through the validator's ``checkMotion``, so a kernel error reaches the caller as
+    the Python exception nanobind raises, with nothing stored to re-raise."""
     native = solve_natively(setup, spec, scenario.start, scenario.goal, time_limit, seed, simplify,
                             spec.kd_tree)  # fmt: skip
-    if native.solved and spec.kc:
-        setup.validator.raise_error()
     return _Solved(
         native.solved, native.time, native.simplify_time, native.states,
         _joint_length(native.states), _joint_length(native.raw_states),
