@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from kcplan._kernel import COAL_CLEARANCE_RTOL
+from kcplan._kernel import COAL_CLEARANCE_RTOL, CloudOrder
 from kcplan._kernel import Robot as KernelRobot
 from kcplan._kernel import World as KernelWorld
 
@@ -26,9 +26,9 @@ SURFACE = 4000
 UNIT = sphere_points(SURFACE)
 
 
-def _world(points: np.ndarray, radius: float, axes) -> KernelWorld:
+def _world(points: np.ndarray, radius: float, axes, order=CloudOrder.morton) -> KernelWorld:
     world = KernelWorld(KernelRobot(3, list(map(float, axes)), [0, 0, 0, 0, 0, 0, 1]), 1.0, 0, 0)
-    world.add_points(np.ascontiguousarray(points, dtype=float), radius)
+    world.add_points(np.ascontiguousarray(points, dtype=float), radius, order)
     world.finalize()
     return world
 
@@ -54,9 +54,12 @@ def clouds(draw):
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)
     n = draw(st.integers(1, 400))
-    kind = draw(st.sampled_from(("blob", "plane", "shell")))
+    kind = draw(st.sampled_from(("blob", "plane", "shell", "repeated")))
     if kind == "blob":
         points = rng.normal(scale=draw(f(0.05, 1.0)), size=(n, 3))
+    elif kind == "repeated":  # many points in one Morton cell, and the same point again
+        points = np.repeat(rng.normal(scale=0.3, size=(n // 20 + 1, 3)), 20, axis=0)[:n]
+        points[: n // 2] += rng.normal(scale=1e-5, size=(n // 2, 3))
     elif kind == "plane":
         points = np.column_stack([rng.uniform(-1, 1, (n, 2)), np.full(n, draw(f(-0.6, 0.6)))])
     else:
@@ -70,10 +73,10 @@ def clouds(draw):
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(clouds())
-def test_the_tree_finds_what_measuring_every_point_finds(case):
+@given(clouds(), st.sampled_from([CloudOrder.morton, CloudOrder.median]))
+def test_the_tree_finds_what_measuring_every_point_finds(case, order):
     points, radius, axes, pose = case
-    world = _world(points, radius, axes)
+    world = _world(points, radius, axes, order)
     brute = _coal_distances(points, radius, axes, pose)
     (d,) = world.body_distances(pose)
     # coal's GJK stops a little above the distance (within the kernel's allowance, and

@@ -33,6 +33,17 @@ std::array<Vec3s, 26> dop_directions() {
 
 const std::array<Vec3s, 26> kDopDirections = dop_directions();
 
+/// The 10 low bits of `v` spread to every third bit (bit i to bit 3 i): one axis of a
+/// Morton code.
+std::uint64_t spread_bits(std::uint32_t v) {
+  std::uint64_t x = v & 0x3ffu;
+  x = (x | (x << 16)) & 0x030000ffu;
+  x = (x | (x << 8)) & 0x0300f00fu;
+  x = (x | (x << 4)) & 0x030c30c3u;
+  x = (x | (x << 2)) & 0x09249249u;
+  return x;
+}
+
 }  // namespace
 
 const PointCloud::Dop& PointCloud::dop_of(const coal::CollisionGeometry& hull,
@@ -132,7 +143,8 @@ struct PointCloud::Query {
   }
 };
 
-PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, std::size_t leaf_size)
+PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, CloudOrder order,
+                       std::size_t leaf_size)
     : radius_(radius) {
   if (n == 0) throw std::invalid_argument("point cloud: expected at least one point");
   if (n >= std::numeric_limits<std::uint32_t>::max())
@@ -147,17 +159,24 @@ PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, std::siz
       throw std::invalid_argument("point cloud: expected finite coordinates");
     points_.emplace_back(p[0], p[1], p[2]);
   }
-  nodes_.reserve(4 * (n / leaf_size + 1));
+  // a split leaves at least one point on each side: at most 2 n - 1 nodes
+  nodes_.reserve(order == CloudOrder::median ? 4 * (n / leaf_size + 1) : 2 * n);
   nodes_.resize(1);
-  build(0, 0, static_cast<std::uint32_t>(n), leaf_size);
+  if (order == CloudOrder::median) {
+    build_median(0, 0, static_cast<std::uint32_t>(n), leaf_size);
+  } else {
+    const std::vector<std::uint32_t> codes = sort_morton();
+    Vec3s lo, hi;
+    build_cells(0, 0, static_cast<std::uint32_t>(n), codes, leaf_size, lo, hi);
+  }
   const Node& root = nodes_[0];
   const Vec3s grow = root.half + Vec3s::Constant(radius_);
   bounds_ = coal::AABB(root.centre - grow, root.centre + grow);
   ball_ = std::make_shared<coal::Sphere>(radius_);
 }
 
-void PointCloud::build(std::size_t index, std::uint32_t begin, std::uint32_t end,
-                       std::size_t leaf_size) {
+void PointCloud::build_median(std::size_t index, std::uint32_t begin, std::uint32_t end,
+                              std::size_t leaf_size) {
   Vec3s lo = points_[begin], hi = points_[begin];
   for (std::uint32_t i = begin + 1; i < end; ++i) {
     lo = lo.cwiseMin(points_[i]);
@@ -174,8 +193,81 @@ void PointCloud::build(std::size_t index, std::uint32_t begin, std::uint32_t end
   const std::size_t left = nodes_.size();
   nodes_.resize(left + 2);
   nodes_[index].left = static_cast<std::int32_t>(left);
-  build(left, begin, middle, leaf_size);
-  build(left + 1, middle, end, leaf_size);
+  build_median(left, begin, middle, leaf_size);
+  build_median(left + 1, middle, end, leaf_size);
+}
+
+std::vector<std::uint32_t> PointCloud::sort_morton() {
+  const std::size_t n = points_.size();
+  Vec3s lo = points_[0], hi = points_[0];
+  for (const Vec3s& p : points_) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // cubic cells (one scale on every axis), 1024 to the box's longest side
+  const double side = (hi - lo).maxCoeff();
+  const double scale = side > 0.0 ? 1023.0 / side : 0.0;
+  auto cell = [scale](double v) {
+    return static_cast<std::uint32_t>(std::clamp(v * scale, 0.0, 1023.0));
+  };
+  // a key: the code in bits 32-61, the point's index below it
+  std::vector<std::uint64_t> keys(n), sorted(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3s d = points_[i] - lo;
+    const std::uint64_t code =
+        spread_bits(cell(d[0])) | spread_bits(cell(d[1])) << 1 | spread_bits(cell(d[2])) << 2;
+    keys[i] = code << 32 | i;
+  }
+  // least significant digit first, 10 bits a pass: 3 passes, each stable
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::array<std::uint32_t, 1025> start{};
+    for (const std::uint64_t k : keys) ++start[((k >> shift) & 1023u) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    for (const std::uint64_t k : keys) sorted[start[(k >> shift) & 1023u]++] = k;
+    keys.swap(sorted);
+  }
+  std::vector<Vec3s> ordered(n);
+  std::vector<std::uint32_t> codes(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    ordered[i] = points_[keys[i] & 0xffffffffu];
+    codes[i] = static_cast<std::uint32_t>(keys[i] >> 32);
+  }
+  points_.swap(ordered);
+  return codes;
+}
+
+void PointCloud::build_cells(std::size_t index, std::uint32_t begin, std::uint32_t end,
+                             const std::vector<std::uint32_t>& codes, std::size_t leaf_size,
+                             Vec3s& lo, Vec3s& hi) {
+  std::int32_t left = -1;
+  if (end - begin <= leaf_size) {
+    lo = hi = points_[begin];
+    for (std::uint32_t i = begin + 1; i < end; ++i) {
+      lo = lo.cwiseMin(points_[i]);
+      hi = hi.cwiseMax(points_[i]);
+    }
+  } else {  // the children side by side: left at `left`, right at `left + 1`
+    // split where the highest bit in which the range's codes differ turns to 1 (the
+    // codes are sorted: every code before has it 0); one cell: at the middle
+    std::uint32_t middle = begin + (end - begin) / 2;
+    const std::uint32_t differ = codes[begin] ^ codes[end - 1];
+    if (differ != 0) {
+      std::uint32_t bit = 1u << 31;
+      while ((differ & bit) == 0) bit >>= 1;
+      middle = static_cast<std::uint32_t>(
+          std::partition_point(codes.begin() + begin, codes.begin() + end,
+                               [bit](std::uint32_t c) { return (c & bit) == 0; }) -
+          codes.begin());
+    }
+    left = static_cast<std::int32_t>(nodes_.size());
+    nodes_.resize(nodes_.size() + 2);
+    Vec3s right_lo, right_hi;
+    build_cells(left, begin, middle, codes, leaf_size, lo, hi);
+    build_cells(left + 1, middle, end, codes, leaf_size, right_lo, right_hi);
+    lo = lo.cwiseMin(right_lo);
+    hi = hi.cwiseMax(right_hi);
+  }
+  nodes_[index] = Node{0.5 * (lo + hi), 0.5 * (hi - lo), begin, end, left};
 }
 
 double PointCloud::exact(Query& q, std::size_t i, Vec3s& towards) {

@@ -35,10 +35,24 @@ struct CloudBounds {
   bool centre_line = true;  ///< the support along the centres' line (not for hulls)
 };
 
+/// How a cloud's tree orders its points before splitting them in halves.
+enum class CloudOrder {
+  /// Sorted once along a Morton (Z-order) curve of 10 bits per axis (cubic cells, 1024 to
+  /// the cloud's longest side), by a radix sort in O(n); a node's range is split where
+  /// its cell splits (the highest bit in which its codes differ: an octree's cells, the
+  /// empty ones skipped), and its box is the union of its children's (Karras's linear
+  /// BVH, as a build on the CPU).
+  morton,
+  /// A k-d tree: median splits (std::nth_element) along the longest side of each node's
+  /// box, O(n log n). The ablation of `morton`.
+  median,
+};
+
 /// The union of the balls of radius `radius()` about the points, as an obstacle.
 ///
-/// The points are kept in a k-d tree (median splits along a box's longest side, leaves of
-/// at most `leaf_size` points); each node keeps its points' bounding box. A query shape S
+/// The points are kept in a balanced binary tree of leaves of at most `leaf_size` points
+/// (ordered as CloudOrder says); each node keeps its points' bounding box. Which order
+/// built the tree changes how much work a query does, never its answer. A query shape S
 /// (an ellipsoid, ball, capsule or convex polytope placed by its coal object: what
 /// ShapeSupport describes) is measured against a node by two lower bounds of the distance
 /// from S to any point of the node's box B, and the larger is used:
@@ -78,7 +92,8 @@ struct CloudBounds {
 class PointCloud {
  public:
   /// `xyz`: n x 3 row-major coordinates (world frame).
-  PointCloud(const double* xyz, std::size_t n, double radius, std::size_t leaf_size = 8);
+  PointCloud(const double* xyz, std::size_t n, double radius,
+             CloudOrder order = CloudOrder::morton, std::size_t leaf_size = 8);
 
   std::size_t size() const { return points_.size(); }
   double radius() const { return radius_; }
@@ -117,8 +132,18 @@ class PointCloud {
   /// The Dop of a link's hull (an immutable SupportedConvex), made on its first query.
   const Dop& dop_of(const coal::CollisionGeometry& hull, const VertexSupport& support);
 
-  /// Fill node `index` (already allocated) with points_[begin, end) and its subtree.
-  void build(std::size_t index, std::uint32_t begin, std::uint32_t end, std::size_t leaf_size);
+  /// Fill node `index` (already allocated) with points_[begin, end) and its subtree, the
+  /// points split at the median of the box's longest side (CloudOrder::median).
+  void build_median(std::size_t index, std::uint32_t begin, std::uint32_t end,
+                    std::size_t leaf_size);
+  /// Sort points_ along the Morton curve (CloudOrder::morton); their sorted codes.
+  std::vector<std::uint32_t> sort_morton();
+  /// Fill node `index` (already allocated) with points_[begin, end) and its subtree, the
+  /// range split between the two halves of its Morton cell; the box from the children's;
+  /// `lo`, `hi` get its corners.
+  void build_cells(std::size_t index, std::uint32_t begin, std::uint32_t end,
+                   const std::vector<std::uint32_t>& codes, std::size_t leaf_size,
+                   coal::Vec3s& lo, coal::Vec3s& hi);
   /// GJK's distance from the query shape to the ball about point i (<= 0: contact).
   /// `towards` gets GJK's unit direction from the ball to the shape (zero if none).
   double exact(Query& q, std::size_t i, coal::Vec3s& towards);

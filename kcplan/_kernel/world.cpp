@@ -385,15 +385,28 @@ void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>
   if (planes->usable()) planes_.back() = std::move(planes);
 }
 
-void World::add_points(const double* xyz, std::size_t n, double radius) {
+void World::add_points(const double* xyz, std::size_t n, double radius, CloudOrder order) {
   if (dimension_ != 3) throw std::invalid_argument("point cloud: a 3D obstacle");
-  auto cloud = std::make_unique<PointCloud>(xyz, n, radius);
+  auto cloud = std::make_unique<PointCloud>(xyz, n, radius, order);
   // the broad phase sees the cloud's box; its narrow phase is the cloud's own
   const coal::AABB& box = cloud->bounds();
   const Vec3s side = box.max_ - box.min_;
   add(std::make_shared<coal::Box>(side[0], side[1], side[2]),
       coal::Transform3s(coal::Matrix3s::Identity(), box.center()), Support{});
   clouds_.back() = std::move(cloud);
+}
+
+void World::set_cloud_order(CloudOrder order) {
+  for (auto& cloud : clouds_) {
+    if (!cloud) continue;
+    const std::vector<Vec3s>& points = cloud->points();
+    std::vector<double> xyz;
+    xyz.reserve(3 * points.size());
+    for (const Vec3s& p : points) xyz.insert(xyz.end(), {p[0], p[1], p[2]});
+    auto rebuilt = std::make_unique<PointCloud>(xyz.data(), points.size(), cloud->radius(), order);
+    rebuilt->bounds_used = cloud->bounds_used;
+    cloud = std::move(rebuilt);
+  }
 }
 
 CloudCounters World::cloud_counters() const {

@@ -113,7 +113,8 @@ class World {
   /// row-major), one obstacle whose narrow phase is its PointCloud (its k-d tree, then
   /// coal's GJK per point that the tree's bounds leave undecided). Like a mesh it has no
   /// support function: region queries keep only its clearance.
-  void add_points(const double* xyz, std::size_t n, double radius);
+  void add_points(const double* xyz, std::size_t n, double radius,
+                  CloudOrder order = CloudOrder::morton);
   /// Register every obstacle in the broad phase (once, after the last add_*).
   void finalize();
 
@@ -207,6 +208,8 @@ class World {
     for (auto& cloud : clouds_)
       if (cloud) cloud->bounds_used = bounds;
   }
+  /// Rebuild every cloud's tree in `order` (for ablations: the answers stay the same).
+  void set_cloud_order(CloudOrder order);
   void reset_cloud_counters() {
     for (auto& cloud : clouds_)
       if (cloud) cloud->counters = CloudCounters{};

@@ -55,7 +55,7 @@ def _box(obstacle: Obstacle, support) -> NDArray[np.float64]:
     """A piece's bounding box ``[low, high]``, from its support function along the axes
     (``high_i = h(e_i)``, ``low_i = -h(-e_i)``) or a mesh's vertices."""
     if support is None:
-        return np.array([obstacle.vertices.min(axis=0), obstacle.vertices.max(axis=0)])
+        return obstacle.vertex_box
     axes = np.eye(3)
     return np.array([[-support(-e) for e in axes], [support(e) for e in axes]])
 
@@ -122,11 +122,7 @@ class ArmWorld:
             corners = [
                 corner
                 for ob in self.obstacles
-                for corner in (
-                    (ob.vertices.min(axis=0), ob.vertices.max(axis=0))
-                    if ob.kind in CLOUD_KINDS
-                    else (ob.center,)
-                )
+                for corner in (ob.vertex_box if ob.kind in CLOUD_KINDS else (ob.center,))
             ] or [np.zeros(3)]
             size = max(2.0, float(np.ptp(np.array(corners), axis=0).max()))
         self.size = float(size)
