@@ -73,8 +73,10 @@ struct PointCloud::Query {
   coal::Matrix3s rotation;  // the shape's frame
   Vec3s origin;
   const Dop* dop = nullptr;  // a hull's supports along kDopDirections (its frame), or null
-  std::array<Vec3s, 26> dop_normals, dop_spans;  // those planes in the world: n, |n|
-  std::array<double, 26> dop_offsets;
+  // those planes in the world, a coordinate to an array (26 products at once): the
+  // normals n, their absolute values |n| (a box's half sides' reach) and the offsets
+  using Planes = Eigen::Array<double, 26, 1>;
+  Planes dop_x, dop_y, dop_z, dop_span_x, dop_span_y, dop_span_z, dop_offsets;
 
   CloudBounds use;
 
@@ -87,9 +89,11 @@ struct PointCloud::Query {
       dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
       // the planes in the world: d . x <= h_d + d . t for the world's d = R d_local
       for (std::size_t j = 0; j < kDopDirections.size(); ++j) {
-        dop_normals[j] = rotation * kDopDirections[j];
-        dop_offsets[j] = (*dop)[j] + dop_normals[j].dot(origin);
-        dop_spans[j] = dop_normals[j].cwiseAbs();
+        const Vec3s n = rotation * kDopDirections[j];
+        dop_x[j] = n[0], dop_y[j] = n[1], dop_z[j] = n[2];
+        dop_span_x[j] = std::abs(n[0]), dop_span_y[j] = std::abs(n[1]);
+        dop_span_z[j] = std::abs(n[2]);
+        dop_offsets[j] = (*dop)[j] + n.dot(origin);
       }
     }
     scale = 1.0 + support.centre.norm() + std::abs(support.spread_high);
@@ -107,33 +111,34 @@ struct PointCloud::Query {
   }
 
   /// A lower bound of the distance from the shape to any point of the box about `m` of
-  /// half sides `half` (a point: half = 0), less rounding, or a number at least `best`
-  /// as soon as one is known (the cheap bounds first: the boxes' gap, a hull's 26 fixed
-  /// planes, its bounding ball, the kept planes, and only then, for a shape other than a
-  /// polytope, the support along the centres' line).
+  /// half sides `half` (a point: `Point` true, half = 0), less rounding, or a number at
+  /// least `best` as soon as one is known (the cheap bounds first: the boxes' gap, the
+  /// shape's bounding ball, a hull's 26 fixed planes, the kept planes, and only then, for
+  /// a shape other than a polytope, the support along the centres' line).
+  template <bool Point>
   double bound(const Vec3s& m, const Vec3s& half, double best) const {
-    const double rho = half.norm();
+    const double rho = Point ? 0.0 : half.norm();
     const double slack = 1e-12 * (scale + m.norm() + rho);
     const coal::AABB& b = *box;  // the boxes' gap: the shape lies in its box
-    const Vec3s out = (b.min_ - half - m).cwiseMax(m - half - b.max_).cwiseMax(0.0);
+    const Vec3s out = Point ? Vec3s((b.min_ - m).cwiseMax(m - b.max_).cwiseMax(0.0))
+                            : Vec3s((b.min_ - half - m).cwiseMax(m - half - b.max_).cwiseMax(0.0));
     double lower = out.norm();
-    if (lower - slack >= best) return lower - slack;
-    if (!supported) return lower - slack;
-    if (dop != nullptr) {  // the hull lies in {x : n . x <= h} for each of the 26 planes,
-      // the box in {y : n . y >= n . m - |n| . half}
-      double most = -std::numeric_limits<double>::infinity();
-      for (std::size_t j = 0; j < kDopDirections.size(); ++j)
-        most = std::max(most, dop_normals[j].dot(m) - dop_spans[j].dot(half) - dop_offsets[j]);
-      lower = std::max(lower, most);
-      if (lower - slack >= best) return lower - slack;
-    }
+    if (lower - slack >= best || !supported) return lower - slack;
     const Vec3s d = m - support.centre;
     const double length = d.norm();
     lower = std::max(lower, length - support.spread_high - rho);  // the shape's ball
     if (lower - slack >= best) return lower - slack;
+    if (dop != nullptr) {  // the hull lies in {x : n . x <= h} for each of the 26 planes,
+      // the box in {y : n . y >= n . m - |n| . half}
+      Planes gap = dop_x * m[0] + dop_y * m[1] + dop_z * m[2] - dop_offsets;
+      if (!Point) gap -= dop_span_x * half[0] + dop_span_y * half[1] + dop_span_z * half[2];
+      lower = std::max(lower, gap.maxCoeff());
+      if (lower - slack >= best) return lower - slack;
+    }
     // each kept plane: the shape lies in {n . x <= h}, the box in {n . y >= n . m - |n| . half}
     for (int j = 0; j < planes; ++j)
-      lower = std::max(lower, normals[j].dot(m) - normals[j].cwiseAbs().dot(half) - offsets[j]);
+      lower = std::max(lower, normals[j].dot(m) - (Point ? 0.0 : normals[j].cwiseAbs().dot(half)) -
+                                  offsets[j]);
     if (lower - slack >= best) return lower - slack;
     // a polytope's support is a scan of its vertices: it cost more than it saved
     // (scripts/cloud_bounds.py), so hulls go to GJK here; an ellipsoid's is one product
@@ -297,7 +302,7 @@ double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towar
   // a node's bound: the larger of the boxes' gap and the separation along the centres
   auto node_bound = [&](const Node& node) {
     ++counters.nodes;
-    return q.bound(node.centre, node.half, best + radius_) - radius_;
+    return q.bound<false>(node.centre, node.half, best + radius_) - radius_;
   };
   stack_.clear();
   if (node_bound(nodes_[0]) < best) stack_.push_back(0);
@@ -307,7 +312,7 @@ double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towar
     if (node.left < 0) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
         ++counters.points;
-        const double bound = q.bound(points_[i], Vec3s::Zero(), best + radius_) - radius_;
+        const double bound = q.bound<true>(points_[i], Vec3s::Zero(), best + radius_) - radius_;
         if (bound >= best) continue;
         Vec3s dir;
         double d;
