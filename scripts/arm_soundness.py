@@ -7,8 +7,8 @@ in the joint limits and valid for the cover (OMPL's contract: an edge starts at 
 state), ``q'`` uniform in the limits and ``q2 = q1 + t (q' - q1)`` with ``t`` log-uniform
 in ``[0.01, 1]``. The joints outside the group (fingers) are fixed at the first problem's
 start values. Each edge is decided by the compiled certifier
-(:class:`kcplan.planning.kernel.KernelArmCertifier`) and, for the first ``--twin`` edges,
-also by its Python twin (:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`), both
+(:class:`kcplan.certification.kernel.KernelArmCertifier`) and, for the first ``--twin`` edges,
+also by its Python twin (:class:`kcplan.certification.arm_certifier.ArmEdgeCertifier`), both
 with the certificates of the ``kc-*`` planners (the clearance balls and the KC guards of
 inflation ``--kc-inflation``; 0: the balls alone, as ``ca-*``).
 
@@ -83,8 +83,8 @@ from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.attach import Attached, attach
 from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
 from kcplan.arm.verify import ArmMeshChecker
-from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import sample_surface_points, voxel_filter
 

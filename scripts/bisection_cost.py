@@ -7,8 +7,8 @@ quarter of it), counts the FCL queries the KC certifier spends on each edge it c
 OMPL's discrete validator spends on the same edge (one per state at 1 % resolution,
 ``validSegmentCount``), and relates both to the edge's minimum clearance (gap-free
 verification), in units of the robot's largest semi-axis. ``--backend kernel`` (the
-default) certifies with the compiled :class:`kcplan.planning.kernel.KernelCertifier`,
-``python`` with :class:`kcplan.planning.certifier.EdgeCertifier` (the same decisions and
+default) certifies with the compiled :class:`kcplan.certification.kernel.KernelCertifier`,
+``python`` with :class:`kcplan.certification.certifier.EdgeCertifier` (the same decisions and
 counters)::
 
     python scripts/bisection_cost.py scenarios/2d/narrow_corridor.yaml ... \
@@ -21,8 +21,8 @@ import argparse
 
 import numpy as np
 
-from kcplan.planning.certifier import EdgeCertifier
-from kcplan.planning.kernel import KernelCertifier
+from kcplan.certification.certifier import EdgeCertifier
+from kcplan.certification.kernel import KernelCertifier
 from kcplan.planning.states import set_state, state_pose, state_space
 from kcplan.planning.verify import verify_path
 from kcplan.scenarios import load_scenario

@@ -12,9 +12,9 @@ kc-rrtconnect / rrtconnect runs between a start and a goal 30 apart::
         [--runs 3] [--time 20] [--backend kernel]
 
 ``--backend kernel`` (the default) certifies with the compiled
-:class:`kcplan.planning.kernel.KernelCertifier` on coal (the world build includes the
+:class:`kcplan.certification.kernel.KernelCertifier` on coal (the world build includes the
 kernel's) and plans with kc-rrtconnect and rrtconnect; ``python`` certifies with
-:class:`kcplan.planning.certifier.EdgeCertifier` on python-fcl and plans with their
+:class:`kcplan.certification.certifier.EdgeCertifier` on python-fcl and plans with their
 python-fcl twins, kc-rrtconnect-py and rrtconnect-fcl.
 """
 
@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
-from kcplan.planning.kernel import KernelCertifier
+from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.certification.kernel import KernelCertifier
 from kcplan.planning.problem import plan, seed_ompl
 from kcplan.scenarios import load_scenario, parse_scenario
 from kcplan.world import CollisionWorld

@@ -10,8 +10,8 @@ robot poses reach or leave it: the kernel's mesh planes and coal's BVH both deci
 origin (:func:`kcplan.world.clutter.random_robot`: long levers, the region certificate's
 arc rule; the paper's polytope, for one body at the origin, is left out), each
 decided by the certifier (``--backend
-kernel``: the compiled :class:`kcplan.planning.kernel.KernelCertifier`, the default;
-``python``: the Python :class:`kcplan.planning.certifier.EdgeCertifier`) with every
+kernel``: the compiled :class:`kcplan.certification.kernel.KernelCertifier`, the default;
+``python``: the Python :class:`kcplan.certification.certifier.EdgeCertifier`) with every
 certificate set of the ablation (``ca``, ``kc-paper``, ``kc``, ``kc-lever``). Every accepted edge is
 re-checked by gap-free conservative advancement with FCL clearances
 (:func:`kcplan.planning.verify.verify_path`, which shares no code with the certificates);
@@ -32,9 +32,9 @@ import time
 import numpy as np
 import trimesh
 
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
-from kcplan.planning.kernel import KernelCertifier
-from kcplan.planning.ladder import GuardLadder
+from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.certification.kernel import KernelCertifier
+from kcplan.certification.ladder import GuardLadder
 from kcplan.planning.verify import verify_path
 from kcplan.world import CollisionWorld, Scenario
 from kcplan.world.clutter import random_pose, random_robot, random_scenario

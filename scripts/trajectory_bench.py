@@ -4,7 +4,7 @@ For the first ``--per-class`` problems of each class of a robot's MBM archive (t
 scenarios ``kcplan import mbm`` writes, each link its own convex hull), kc-rrtconnect
 plans (``--time`` seconds, seed ``--seed``, OMPL's simplifier on), then the path is
 smoothed by certified blends and timed by TOPP-RA within the URDF's velocity limits and
-the default acceleration limits (:func:`kcplan.planning.trajectory.certified_trajectory`).
+the default acceleration limits (:func:`kcplan.trajectory.certified.certified_trajectory`).
 Each trajectory is then checked by code independent of its certificate:
 
 - its limits at 1 kHz (``|qd_j| / v_j`` and ``|qdd_j| / a_j``, the largest; tolerance
@@ -15,7 +15,7 @@ Each trajectory is then checked by code independent of its certificate:
 and its duration is set against the same path timed alike with a stop at every corner.
 With ``--corners N`` it also draws N random corners per problem (two certified edges
 through a random configuration of the scene) and re-checks every blend
-:func:`kcplan.planning.smoothing.certify_blends` accepts there on the meshes (the
+:func:`kcplan.trajectory.smoothing.certify_blends` accepts there on the meshes (the
 smoothing's soundness study).
 
 It prints (and writes to ``DIR/trajectory_table.md``, rows to ``DIR/rows.json``) per
@@ -46,9 +46,9 @@ from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive, mbm_scenario
 from kcplan.arm.verify import ArmMeshChecker
 from kcplan.files import write_text_atomic
 from kcplan.planning.problem import plan
-from kcplan.planning.smoothing import certify_blends
 from kcplan.scenarios import dump_scenario, parse_scenario
 from kcplan.trajectory.curve import BlendedPath
+from kcplan.trajectory.smoothing import certify_blends
 
 ROOT = Path(__file__).resolve().parents[1]
 MBM = ROOT.parent / "shared" / "data" / "external" / "mbm"

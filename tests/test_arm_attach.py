@@ -10,7 +10,7 @@ from conftest import PANDA, PANDA_GROUP
 from kcplan.arm import ArmError, ArmWorld, load_arm
 from kcplan.arm.attach import Attached, attach, detach
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.scenarios import check_start_goal, parse_scenario
 from kcplan.world import ScenarioError
 

@@ -1,6 +1,6 @@
 """Bad input and faults for arms (issue 25, item 9): Hypothesis fuzz of both arm
-certifiers (the compiled :class:`kcplan.planning.kernel.KernelArmCertifier` and its Python
-twin :class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`) with joint values that are
+certifiers (the compiled :class:`kcplan.certification.kernel.KernelArmCertifier` and its Python
+twin :class:`kcplan.certification.arm_certifier.ArmEdgeCertifier`) with joint values that are
 not finite, outside the limits by tiny to huge amounts, or of the wrong length; every
 fuzzed edge they accept between valid states re-checked on the links' own meshes
 (:func:`kcplan.arm.verify.verify_arm_path`); and robots that cannot be built (no
@@ -22,8 +22,8 @@ from hypothesis import strategies as st
 from kcplan.arm import ArmError, load_arm
 from kcplan.arm.scenario import parse_arm_scenario
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.arm_certifier import ArmEdgeCertifier
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import ArmEdgeCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.world.fields import ScenarioError
 
 MARGINS = [1e-12, 1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e100, 1e308]

@@ -35,7 +35,7 @@ from kcplan.arm.hulls import CYLINDER_SIDES, box_hull, cylinder_hull, points_hul
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.pairs import prove_pairs
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.scenarios import parse_scenario
 from kcplan.world import ScenarioError
 

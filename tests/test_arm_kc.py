@@ -1,4 +1,4 @@
-"""The KC certificate of arms (kcplan.planning.arm_certifier, ArmCertifier's kc_inflation):
+"""The KC certificate of arms (kcplan.certification.arm_certifier, ArmCertifier's kc_inflation):
 bodies stay inside their grown guards within the reach it gives, checked on sampled
 surface points placed by the forward kinematics; the grown guards' queries and the
 decisions are the same in both twins (tests/test_arm_kernel.py checks accepted edges on
@@ -16,8 +16,8 @@ from kcplan.arm.bounds import (
     twists,
 )
 from kcplan.arm.kinematics import body_frames
-from kcplan.planning.arm_certifier import ArmEdgeCertifier, _kc_reaches
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import ArmEdgeCertifier, _kc_reaches
+from kcplan.certification.kernel import KernelArmCertifier
 
 EPS = 0.2
 
@@ -47,7 +47,7 @@ def _reaches(panda, qm, step, first_order=True):
 def test_a_body_stays_inside_its_grown_guard_within_its_kc_reach(panda, free, first_order):
     """On either side of a guard at s = m, up to the KC reach, every sampled surface point
     of every body lies inside that body grown by 1 + eps at q(m) (the (KC) condition of
-    kcplan.planning.arm_certifier), and some reaches beat the clearance a body would need
+    kcplan.certification.arm_certifier), and some reaches beat the clearance a body would need
     for the ball to go as far."""
     u = np.random.default_rng(3).normal(size=(300, 3))
     u /= np.linalg.norm(u, axis=1)[:, None]

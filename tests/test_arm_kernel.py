@@ -1,6 +1,6 @@
 """The compiled twin of arms (kcplan/_kernel: Chain, ArmWorld, ArmCertifier) against its
 Python reference (kcplan.arm.kinematics, kcplan.arm.bounds, kcplan.arm.world,
-kcplan.planning.arm_certifier) and against Pinocchio, with every accepted edge re-checked
+kcplan.certification.arm_certifier) and against Pinocchio, with every accepted edge re-checked
 on the links' own meshes."""
 
 import fcl
@@ -25,8 +25,8 @@ from kcplan.arm.bounds import (
 )
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import ARM_COUNTER_NAMES, ArmEdgeCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.world.obstacles import Obstacle
 
 CYLINDER = Obstacle(  # as kcplan.arm.scenario reads one: extents (r, r, h / 2)
@@ -300,7 +300,7 @@ def test_the_guard_cache_saves_guards_and_changes_no_decision(panda, world, stat
     check remembered) decides every edge of a star of edges, asked twice, as the default
     one, which measures fewer guards: the edges that share a state share its guard. (The
     Python twin gets the same one-entry cache.)"""
-    from kcplan.planning.certifiers import certifier_for
+    from kcplan.certification.certifiers import certifier_for
 
     twin = certifier_for(panda, world, "python", guard_cache=False)
     assert twin.cache.max_entries == 1

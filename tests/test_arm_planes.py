@@ -1,4 +1,4 @@
-"""The free-region planes of arms (the plane certificate of kcplan.planning.arm_certifier).
+"""The free-region planes of arms (the plane certificate of kcplan.certification.arm_certifier).
 
 The bound the certificate rests on is checked against the links' hulls moved by
 Pinocchio's kinematics (no certificate code involved); a hand sliding over a round
@@ -15,8 +15,8 @@ from kcplan.arm import ArmWorld
 from kcplan.arm.bounds import point_accelerations, twists
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.arm_certifier import ArmEdgeCertifier
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import ArmEdgeCertifier
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.world.obstacles import Obstacle
 
 BODIES_PER_LINK = None  # the links' own hulls (kcplan's default representation)

@@ -1,4 +1,4 @@
-"""Certified joint-space edges of arms (kcplan.planning.arm_certifier) and planning with
+"""Certified joint-space edges of arms (kcplan.certification.arm_certifier) and planning with
 them in OMPL, every accepted edge re-checked on the links' own meshes."""
 
 import math
@@ -12,8 +12,12 @@ from ompl import geometric as og
 
 from kcplan.arm import ArmWorld
 from kcplan.arm.verify import ArmMeshChecker, verify_arm_path
-from kcplan.planning.arm_certifier import ARM_COUNTER_NAMES, DEFAULT_KC_INFLATION, ArmEdgeCertifier
-from kcplan.planning.certifier import COUNTER_NAMES
+from kcplan.certification.arm_certifier import (
+    ARM_COUNTER_NAMES,
+    DEFAULT_KC_INFLATION,
+    ArmEdgeCertifier,
+)
+from kcplan.certification.certifier import COUNTER_NAMES
 from kcplan.planning.states import joint_reader, joint_space, joint_state, set_joint_state
 from kcplan.planning.validator import KCMotionValidator
 
@@ -222,12 +226,12 @@ def test_the_validator_chooses_the_arm_certificates(panda, scene):
 
 
 def test_a_validator_refuses_the_options_of_the_other_kind_of_robot(panda, scene):
-    """The certifier is chosen once (kcplan.planning.certifiers.certifier_for), and each
+    """The certifier is chosen once (kcplan.certification.certifiers.certifier_for), and each
     kind of robot has its own options: an arm's validator refuses a rigid robot's option
     (it used to ignore learn_schedule, horizon, sweep_test and refuse fallback), a rigid
     robot's refuses an arm's, and a typo is named, all as one ValueError."""
-    from kcplan.planning.certifiers import ARM_OPTIONS, RIGID_OPTIONS
-    from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
+    from kcplan.certification.certifiers import ARM_OPTIONS, RIGID_OPTIONS
+    from kcplan.certification.kernel import KernelArmCertifier, KernelCertifier
     from kcplan.planning.states import state_space
     from kcplan.scenarios import load_scenario
     from kcplan.world.collision import CollisionWorld
@@ -277,7 +281,7 @@ def _lazy_setup(scenario, seed: int):
 def _assert_certified_and_free(scenario, states) -> None:
     """Every edge of the path certified by a fresh certifier, and free on the meshes
     without gaps (kcplan.arm.verify, independent of the certificates)."""
-    from kcplan.planning.certifiers import certifier_for
+    from kcplan.certification.certifiers import certifier_for
 
     world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)
     fresh = certifier_for(scenario.arm, world)

@@ -391,8 +391,8 @@ def test_summary_statistics_by_hand():
 
 
 def test_polytope_cache_round_trip_and_repair(tmp_path, monkeypatch):
+    from kcplan.certification import ladder as certificate
     from kcplan.kc.convex import ConvexLowerBound
-    from kcplan.planning import ladder as certificate
 
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
     certificate._halfspaces.cache_clear()

@@ -9,10 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from kcplan.certification.certificates import ClearanceBall, FreeRegionPlanes
+from kcplan.certification.guard import BodyGuard, Guard, GuardCache
 from kcplan.geometry.pose import Edge, rotate_vector
 from kcplan.geometry.rotations import exp_rotation
-from kcplan.planning.certificates import ClearanceBall, FreeRegionPlanes
-from kcplan.planning.guard import BodyGuard, Guard, GuardCache
 from kcplan.scenarios import parse_scenario
 from kcplan.world import CollisionWorld
 from kcplan.world.clutter import random_pose, random_robot, random_scenario
@@ -327,7 +327,7 @@ def test_region_queries_and_certified_edges_with_meshes():
     every accepted edge among them is free under gap-free verification."""
     from pathlib import Path
 
-    from kcplan.planning.certifier import EdgeCertifier
+    from kcplan.certification.certifier import EdgeCertifier
     from kcplan.planning.verify import verify_path
     from kcplan.scenarios import load_scenario
 

@@ -27,9 +27,7 @@ from kcplan import _kernel
 from kcplan._kernel import EdgeCertifier as CompiledCertifier
 from kcplan._kernel import Robot as KernelRobot
 from kcplan._kernel import World as KernelWorld
-from kcplan.geometry.pose import Edge, quaternion_multiply, wrap_angle
-from kcplan.maps.superquadric import bounding_polytopes
-from kcplan.planning.certifier import (
+from kcplan.certification.certifier import (
     CERTIFICATE_SETS,
     COUNTER_NAMES,
     LEARN_EVERY,
@@ -40,9 +38,11 @@ from kcplan.planning.certifier import (
     EdgeCertifier,
     probe_points,
 )
-from kcplan.planning.domain import PoseDomain
-from kcplan.planning.kernel import KernelCertifier
-from kcplan.planning.ladder import GuardLadder
+from kcplan.certification.domain import PoseDomain
+from kcplan.certification.kernel import KernelCertifier
+from kcplan.certification.ladder import GuardLadder
+from kcplan.geometry.pose import Edge, quaternion_multiply, wrap_angle
+from kcplan.maps.superquadric import bounding_polytopes
 from kcplan.planning.states import set_state, state_space
 from kcplan.planning.validator import KCMotionValidator
 from kcplan.planning.verify import verify_path
@@ -657,7 +657,7 @@ def test_no_magnitude_of_any_coordinate_certifies_an_edge_through_a_wall(n, back
 
 @pytest.mark.parametrize("n", [2, 3])
 def test_the_pose_domain_twins_admit_the_same_poses(n):
-    """kcplan/_kernel/domain.hpp and kcplan/planning/domain.py: the same box (bounds padded
+    """kcplan/_kernel/domain.hpp and kcplan/certification/domain.py: the same box (bounds padded
     by their diagonal and the robot's reach), yaw range and quaternion norms, on poses
     just inside and just outside each limit, through the certifiers' state checks."""
     scenario = _closed_room(n)

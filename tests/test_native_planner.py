@@ -11,8 +11,8 @@ from conftest import arm_obstacles, panda_arm
 
 from kcplan import _kernel
 from kcplan.arm import ArmWorld
-from kcplan.planning.arm_certifier import DEFAULT_KC_INFLATION
-from kcplan.planning.kernel import KernelArmCertifier
+from kcplan.certification.arm_certifier import DEFAULT_KC_INFLATION
+from kcplan.certification.kernel import KernelArmCertifier
 from kcplan.planning.problem import plan
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"

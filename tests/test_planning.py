@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from ompl import base as ob
 
+from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.certification.ladder import GuardLadder
 from kcplan.cli import main
 from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.rotations import log_rotation
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
-from kcplan.planning.ladder import GuardLadder
 from kcplan.planning.names import ARM_ONLY, CERTIFIABLE, OMPL_RANGE, RIGID_RANGE
 from kcplan.planning.problem import PLANNERS, plan
 from kcplan.planning.states import set_state, state_pose, state_space

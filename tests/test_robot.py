@@ -10,10 +10,10 @@ from conftest import assert_planner_refused
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.geometry.pose import Edge, pose_frame
 from kcplan.geometry.robot import MAX_BODIES, Body, Robot
 from kcplan.geometry.rotations import exp_rotation
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
 from kcplan.planning.names import SINGLE_ELLIPSOID_ONLY
 from kcplan.planning.problem import PLANNERS
 from kcplan.planning.verify import verify_path
@@ -60,7 +60,7 @@ def support(body_axes, body_pose, R, normal, n):
 def test_support_of_an_offset_body_turns_no_faster_than_its_lever(n, seed, angle):
     """``|h_k(n; R exp(phi w)) - h_k(n; R)| <= (|p_k| + a_max - a_min) phi`` for every
     direction, start orientation, rotation axis and offset (module docstring of
-    :mod:`kcplan.planning.certificates.ball`)."""
+    :mod:`kcplan.certification.certificates.ball`)."""
     rng = np.random.default_rng(seed)
     body = random_robot(rng, n, 1, offset=5.0).bodies[0]
     R = pose_frame(random_pose(rng, n, 0, 1), n)[0]

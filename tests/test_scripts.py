@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from kcplan.planning.certifier import CERTIFICATE_SETS
+from kcplan.certification.certifier import CERTIFICATE_SETS
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ROOT / "scripts"

@@ -49,7 +49,7 @@ def test_the_curve_is_continuous_with_its_tangent_and_stays_near_its_corners(cas
             assert np.allclose(path(s - h, 1) + h * path(s - h, 2), path(s, 1), atol=1e-9 + bend)
     assert np.allclose(path(0.0), W[0]) and np.allclose(path(path.length), W[-1])
     # every point of blend i lies within delta_i max(|u1_j|, |u2_j|) of its corner: the
-    # set kcplan.planning.smoothing proves free
+    # set kcplan.trajectory.smoothing proves free
     units = np.diff(W, axis=0) / np.linalg.norm(np.diff(W, axis=0), axis=1)[:, None]
     curved = np.flatnonzero(path.curved)
     corners = [i for i in range(len(blends)) if path.blends[i] > 0]
@@ -136,7 +136,7 @@ def test_every_certified_blend_is_free_on_the_meshes(box):
     """Random corners of certified edges in an MBM scene: every blend certify_blends
     accepts is checked on the links' own meshes, without gaps (independent code)."""
     from kcplan._kernel import ArmCertifier
-    from kcplan.planning.smoothing import certify_blends
+    from kcplan.trajectory.smoothing import certify_blends
 
     scenario, world, checker = box
     arm = scenario.arm

@@ -13,9 +13,9 @@ C++ (``kcplan/_kernel/``)               Python twin
 ``robot.hpp`` ``Robot``                 :mod:`kcplan.geometry.robot`
 ``world.hpp`` ``World``                 :class:`kcplan.world.CollisionWorld`
 ``occupancy.hpp``                       :mod:`kcplan.world.occupancy`
-``guard.hpp``                           :mod:`kcplan.planning.guard`
-``certificates.hpp``                    :mod:`kcplan.planning.certificates`
-``certifier.hpp`` ``EdgeCertifier``     :mod:`kcplan.planning.certifier`
+``guard.hpp``                           :mod:`kcplan.certification.guard`
+``certificates.hpp``                    :mod:`kcplan.certification.certificates`
+``certifier.hpp`` ``EdgeCertifier``     :mod:`kcplan.certification.certifier`
 ``mesh_planes.hpp`` ``MeshPlanes``      none: python-fcl measures meshes with
                                         FCL's BVH; tested against it
 ``primitive_bound.hpp`` ``Primitive``   none: a shortcut before GJK for boxes, balls
@@ -26,7 +26,7 @@ C++ (``kcplan/_kernel/``)               Python twin
 ``chain.hpp`` ``Chain``                 :mod:`kcplan.arm.kinematics`, :mod:`kcplan.arm.bounds`
 ``arm_world.hpp`` ``ArmWorld``          :class:`kcplan.arm.ArmWorld`
 ``pair_motion.hpp`` ``PairFirstOrder``  :func:`kcplan.arm.bounds.relative_first_order`
-``arm_certifier.hpp`` ``ArmCertifier``  :mod:`kcplan.planning.arm_certifier`
+``arm_certifier.hpp`` ``ArmCertifier``  :mod:`kcplan.certification.arm_certifier`
 ``enclosing.hpp``                       :func:`kcplan.geometry.enclosing.khachiyan_weights`
 ======================================= ======================================================
 

@@ -1,5 +1,5 @@
 // Conservative advancement: guards in the middle of what is left open of an edge.
-// Python twin: kcplan/planning/certifier.py advance(); the rigid and the arm certifiers
+// Python twin: kcplan/certification/certifier.py advance(); the rigid and the arm certifiers
 // both advance by it.
 #pragma once
 

@@ -296,7 +296,7 @@ bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double h
   if (count == 0) return true;
   ++counters.probed_edges;
   // the van der Corput points 1/2, 1/4, 3/4, 1/8, ...: each halves the largest stretch
-  // left unprobed, as bisection would (kcplan/planning/certifier.py probe_points)
+  // left unprobed, as bisection would (kcplan/certification/certifier.py probe_points)
   for (int i = 1; i <= count; ++i) {
     double u = 0.0, bit = 0.5;
     for (int k = i; k > 0; k >>= 1, bit *= 0.5)

@@ -1,5 +1,5 @@
 // The edge certifier of arms: joint-space edges proved free by the chain's clearance balls.
-// Python twin: kcplan/planning/arm_certifier.py (ArmEdgeCertifier); both decide every edge
+// Python twin: kcplan/certification/arm_certifier.py (ArmEdgeCertifier); both decide every edge
 // by the same steps and count them under the rigid certifier's names.
 #pragma once
 
@@ -61,7 +61,7 @@ struct ArmCertifierOptions {
   bool probes = true;    ///< collision probes of the open stretch before any guard
   /// Decide the self pairs of a far group of parts at once (ArmWorld::parts) and ask a
   /// pair's gap only when its group is near; false: every pair at every guard (the
-  /// ablation; the radii are the same, kcplan/planning/arm_certifier.py decides so too).
+  /// ablation; the radii are the same, kcplan/certification/arm_certifier.py decides so too).
   bool part_balls = true;
   /// Bound a body's motion near a guard by its exact twist there as well (Chain::
   /// first_order_speeds, Chain::point_accelerations); false: the levers alone (the
@@ -93,7 +93,7 @@ struct ArmCertifierOptions {
 /// max(d / v, the root t of A t + Q t^2 / 2 = d, that of A1 t + M t^2 / 2 = d):
 /// each body stays clear of the scene and of each body it may collide with, and the
 /// covers hold the links.
-/// kcplan/planning/arm_certifier.py has the proof in full.
+/// kcplan/certification/arm_certifier.py has the proof in full.
 ///
 /// The KC certificate (kc_inflation = eps > 0) is a second proof for each body's scene
 /// clearance, tried where the ball leaves a body short: the body grown about its centre
@@ -101,7 +101,7 @@ struct ArmCertifierOptions {
 /// (World::grown_body_clear), and the body stays inside it while, in the guard's frame,
 /// its centre's displacement d and its turn theta keep |diag(a)^-1 d| + (a_max - a_min)
 /// theta / a_min <= eps (the ellipsoid's support function turns at most a_max - a_min per
-/// radian, kcplan/planning/certificates/ball.py). With d <= u t + M t^2 / 2 (the centre's
+/// radian, kcplan/certification/certificates/ball.py). With d <= u t + M t^2 / 2 (the centre's
 /// velocity u at the guard, Taylor's remainder), d <= min(v t, A t + Q t^2 / 2) and theta
 /// <= w t (Chain::turn_speeds) this is a reach in t like the ball's; a body takes the
 /// larger of the two. A body moving along its long axes may so go much farther than its
@@ -167,7 +167,7 @@ class ArmCertifier {
   /// straight edge of |dq| = bound holds for the curve, and guards placed by conservative
   /// advancement in t (advance(), at most `max_guards`, not cached) prove it. The first
   /// order and the KC guard are not used here: they need a straight edge's signed step.
-  /// kcplan/planning/smoothing.py has the proof and the Python twin.
+  /// kcplan/trajectory/smoothing.py has the proof and the Python twin.
   bool check_blend(const double* a, const double* c, const double* b, int max_guards);
   /// State validity with the cache: one collision query for a state not seen before.
   bool state_valid(const double* q);
@@ -190,7 +190,7 @@ class ArmCertifier {
   /// its rounding margin, still covers the stretch.
   static constexpr double kCapSlack = 1.0 + 1e-6;
   /// Joint-space distance (radians, L2) per probe, and probes per edge at most
-  /// (kcplan/planning/arm_certifier.py: PROBE_STEP, MAX_PROBES).
+  /// (kcplan/certification/arm_certifier.py: PROBE_STEP, MAX_PROBES).
   static constexpr double kProbeStep = 0.1;
   static constexpr int kMaxProbes = 64;
 

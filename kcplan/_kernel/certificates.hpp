@@ -1,5 +1,5 @@
 // Edge certificates: sound rules that prove a stretch of an edge free from one guard.
-// Python twin: kcplan/planning/certificates/ (ball.py, region.py, polytope.py); the proofs
+// Python twin: kcplan/certification/certificates/ (ball.py, region.py, polytope.py); the proofs
 // are in those modules' docstrings, the rules here are the same, line for line.
 #pragma once
 
@@ -137,7 +137,7 @@ class FreeRegionPlanes final : public Certificate {
 /// The paper's convex lower bound P_eps of the largest free guard (1 + eps) E_a on a
 /// ladder: eps <= clearance / max(a); the guard covers the gauge of P_eps along the
 /// edge's KC direction on each side. The rows are A_i / c_i of each level's polytope,
-/// built and proven sound in Python (kcplan/kc/convex.py, cached by planning/ladder.py).
+/// built and proven sound in Python (kcplan/kc/convex.py, cached by certification/ladder.py).
 class KCPolytope final : public Certificate {
  public:
   /// `levels` increasing inflations; `rows[l]` the scaled rows of level l, flat

@@ -1,5 +1,5 @@
 // The edge certifier: where certificates, guards, the guard cache and rejection meet.
-// Python twin: kcplan/planning/certifier.py (EdgeCertifier); both decide every edge by the
+// Python twin: kcplan/certification/certifier.py (EdgeCertifier); both decide every edge by the
 // same steps and count them under the same names (COUNTER_NAMES).
 #pragma once
 
@@ -20,13 +20,13 @@
 
 namespace kcplan {
 
-/// The probes' schedule (kcplan/planning/certifier.py: PROBE_WARMUP, PROBE_ODDS,
+/// The probes' schedule (kcplan/certification/certifier.py: PROBE_WARMUP, PROBE_ODDS,
 /// PROBE_EVERY): every edge is probed while fewer than kProbeWarmup were, or while at
 /// least one probed edge in kProbeOdds was rejected by a probe; otherwise every
 /// kProbeEvery-th edge, so that the rate stays measured.
 constexpr std::int64_t kProbeWarmup = 64, kProbeOdds = 5, kProbeEvery = 16;
 
-/// The occupancy grid's learning schedule (kcplan/planning/certifier.py: LEARN_WARMUP,
+/// The occupancy grid's learning schedule (kcplan/certification/certifier.py: LEARN_WARMUP,
 /// LEARN_ODDS, LEARN_EVERY): the cell of every colliding state is tested while fewer than
 /// kLearnWarmup cells were, or while the grid rejects at least one state or edge per
 /// kLearnOdds tested cells; otherwise at every kLearnEvery-th colliding state.
@@ -34,7 +34,7 @@ constexpr std::int64_t kLearnWarmup = 256, kLearnOdds = 2, kLearnEvery = 8;
 
 /// A piece of work asked while it pays: on each of the first `warmup` tries, and while at
 /// least one try in `odds` paid off; otherwise on every `every`-th, so that the rate
-/// stays measured. Python twin: kcplan/planning/certifier.py, PayingSchedule.
+/// stays measured. Python twin: kcplan/certification/certifier.py, PayingSchedule.
 class PayingSchedule {
  public:
   PayingSchedule(std::int64_t warmup, std::int64_t odds, std::int64_t every)
@@ -49,7 +49,7 @@ class PayingSchedule {
   std::int64_t warmup_, odds_, every_, skips_ = 0;
 };
 
-/// kcplan's counters, with the meanings documented in kcplan/planning/certifier.py.
+/// kcplan's counters, with the meanings documented in kcplan/certification/certifier.py.
 struct CertifierCounters {
   std::int64_t edges = 0, rejected = 0, rejected_end_state = 0, rejected_sweep = 0,
                rejected_occupancy = 0, rejected_probe = 0, rejected_guard = 0, not_proven = 0,

@@ -1,5 +1,5 @@
 // The poses a certifier decides: the others are rejected before any arithmetic on them.
-// Python twin: kcplan/planning/domain.py (PoseDomain; same box, same limits).
+// Python twin: kcplan/certification/domain.py (PoseDomain; same box, same limits).
 #pragma once
 
 #include <algorithm>

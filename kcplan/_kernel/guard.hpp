@@ -1,6 +1,6 @@
 // A guard (what one query at a robot pose proves about the space around it) and the
 // bounded cache of guards and validity of the states a planner keeps.
-// Python twin: kcplan/planning/guard.py (BodyGuard, Guard, GuardCache).
+// Python twin: kcplan/certification/guard.py (BodyGuard, Guard, GuardCache).
 #pragma once
 
 #include <array>

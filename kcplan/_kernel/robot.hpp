@@ -27,7 +27,7 @@ struct Body {
                      position[2] * position[2]);
   }
   /// |p_k| + a_max - a_min: bound on the rate of change of the body's support function
-  /// per radian of robot rotation (proof in kcplan/planning/certificates/ball.py).
+  /// per radian of robot rotation (proof in kcplan/certification/certificates/ball.py).
   double lever() const { return offset() + a_max - a_min; }
   /// |p_k| + a_max: every point of the body lies this close to the robot's origin.
   double reach() const { return offset() + a_max; }

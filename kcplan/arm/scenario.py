@@ -32,8 +32,8 @@ alone fits exactly that many (the smallest union); neither gives
 :data:`kcplan.arm.model.DEFAULT_MAX_OFFSET`. A
 cylinder's axis is its local z. ``inflation`` is the KC guards' ``eps`` of the ``kc-*``
 planners (each body grown by ``1 + eps`` about its centre,
-:mod:`kcplan.planning.arm_certifier`); 0, the default, takes
-:data:`kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`. Every field is validated with
+:mod:`kcplan.certification.arm_certifier`); 0, the default, takes
+:data:`kcplan.certification.arm_certifier.DEFAULT_KC_INFLATION`. Every field is validated with
 the rigid format's one-line errors (:class:`kcplan.world.fields.ScenarioError`).
 """
 

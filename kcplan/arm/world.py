@@ -302,7 +302,7 @@ class ArmWorld:
         :meth:`safe_clearances` measures them. A box, ball or cylinder is taken along the
         line from its point nearest the body's centre where the two are apart along it
         (its clearance then that separation), as the kernel takes it. These are the slabs
-        of the plane certificate (:mod:`kcplan.planning.arm_certifier`; the kernel's
+        of the plane certificate (:mod:`kcplan.certification.arm_certifier`; the kernel's
         ``ArmWorld::body_separations``). One distance query: every body against every
         piece."""
         supports = self._place(state)
@@ -338,7 +338,7 @@ class ArmWorld:
         """Whether each body at ``state``, grown about its centre by ``scale`` (semi-axes
         times ``scale >= 1``), is certainly clear of the obstacles, ``(bodies,)``: its
         distance (module docstring) less FCL's allowance is positive. These are the KC
-        guards of :mod:`kcplan.planning.arm_certifier`; self pairs are not looked at (one
+        guards of :mod:`kcplan.certification.arm_certifier`; self pairs are not looked at (one
         collision query). A hull body has no KC guard: False, not asked."""
         if not (math.isfinite(scale) and scale >= 1.0):
             raise ValueError(f"scale: expected a finite number >= 1, got {scale!r}")

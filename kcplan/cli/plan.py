@@ -171,7 +171,7 @@ def _trajectory_limits(args: argparse.Namespace, scenario, arm: bool):
     if arm and args.speed_limit is not None:
         raise InputError(f"{args.scenario}: --speed-limit: a rigid robot's; an arm's joint "
                          "velocity limits are its URDF's")  # fmt: skip
-    from kcplan.planning.trajectory import joint_limits, rigid_limits
+    from kcplan.trajectory.certified import joint_limits, rigid_limits
 
     given = {}
     for flag in ("speed_limit", "acceleration_limit"):
@@ -219,7 +219,7 @@ def _write_trajectory(args: argparse.Namespace, timed) -> None:
 
 def path_guards(scenario, states) -> list:
     """The guards (pose, inflation) that certify each edge of a path, for plotting."""
-    from kcplan.planning.certifier import EdgeCertifier
+    from kcplan.certification.certifier import EdgeCertifier
     from kcplan.world import CollisionWorld
 
     certifier = EdgeCertifier(CollisionWorld(scenario))

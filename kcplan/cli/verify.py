@@ -141,7 +141,7 @@ def _verify_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
     if args.mesh is not None:
         raise InputError(f"{args.scenario}: --mesh: an arm is checked on its own meshes")
     from kcplan.arm.verify import ArmMeshChecker
-    from kcplan.planning.trajectory import read_trajectory
+    from kcplan.trajectory.certified import read_trajectory
 
     if data.get("joints") != list(arm.joints):
         raise InputError(f"{args.path}: joints: expected the scenario's planning group "
@@ -193,8 +193,8 @@ def _sample_problems(off: dict) -> list[str]:
 def _verify_rigid_trajectory(args: argparse.Namespace, scenario, data: dict) -> int:
     """A rigid robot's trajectory file: its path gap-free (as a path file's), every sample
     on it and within its translational and angular limits."""
-    from kcplan.planning.trajectory import POSE_NAMES, read_rigid_trajectory
     from kcplan.planning.verify import verify_path
+    from kcplan.trajectory.certified import POSE_NAMES, read_rigid_trajectory
     from kcplan.world import CollisionWorld
 
     n = scenario.dimension

@@ -13,7 +13,7 @@ Numbers every certificate needs, per body (lengths in the robot's unit, per radi
 * the *lever* ``|p_k| + a_max,k - a_min,k``: the support function of body ``k`` in any
   fixed direction changes by at most this much per radian of rotation about the robot's
   origin (``|p_k|`` from the arc of the centre, ``a_max - a_min`` from the body's own
-  turning; proof in :mod:`kcplan.planning.certificates.ball`);
+  turning; proof in :mod:`kcplan.certification.certificates.ball`);
 * the *reach* ``|p_k| + a_max,k``: the farthest a point of body ``k`` lies from the
   robot's origin (the plain lever of conservative advancement).
 """

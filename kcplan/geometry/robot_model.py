@@ -14,7 +14,7 @@ KC sets, the arms' chain bounds) on top of it:
   (radians, metres for a prismatic joint), an edge the straight joint-space segment.
 
 The world a robot moves in says what is near its bodies (a ``CollisionWorld`` or an
-``ArmWorld``), and :func:`kcplan.planning.certifiers.certifier_for` combines the two into
+``ArmWorld``), and :func:`kcplan.certification.certifiers.certifier_for` combines the two into
 the certifier, chosen once.
 
 This module imports neither OMPL nor FCL.

@@ -7,9 +7,9 @@ kind) are the thin OMPL adapters. :mod:`.native` runs an arm's planning loop in 
 compiled kernel instead (``kc-rrtconnect-native``), with no OMPL or Python per edge.
 """
 
-from kcplan.planning.certifier import CERTIFICATE_SETS, EdgeCertifier
-from kcplan.planning.guard import Guard, GuardCache
-from kcplan.planning.ladder import DEFAULT_LADDER, GuardLadder
+from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
+from kcplan.certification.guard import Guard, GuardCache
+from kcplan.certification.ladder import DEFAULT_LADDER, GuardLadder
 from kcplan.planning.validator import KCMotionValidator
 
 __all__ = [

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from ompl import base as ob
 from ompl import geometric as og
 
-from kcplan.planning.arm_certifier import PROBE_STEP
+from kcplan.certification.arm_certifier import PROBE_STEP
 
 __all__ = ["LAZY_SCREEN_STEP", "REPAIR_SHARE", "RIGID_SCREEN_STEP", "LazyOutcome", "solve_lazily"]
 

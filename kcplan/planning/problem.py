@@ -21,7 +21,7 @@ from ompl import util as ou
 
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.verify import verify_arm_path
-from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
+from kcplan.certification.certifier import CERTIFICATE_SETS, DEFAULT_PROBES
 from kcplan.planning.lazy import solve_lazily
 from kcplan.planning.names import (
     CERTIFIABLE,
@@ -362,8 +362,8 @@ class PlanResult:
     ``plan`` (:attr:`time`) and ``simplify`` (:attr:`simplify_time`)."""
     trajectory: object = field(default=None, repr=False, compare=False)
     """The timed trajectory along the path when :func:`plan` was asked for it
-    (``trajectory=True``): an arm's :class:`kcplan.planning.trajectory.CertifiedTrajectory`,
-    a rigid robot's :class:`~kcplan.planning.trajectory.RigidTimedPath`; not written to
+    (``trajectory=True``): an arm's :class:`kcplan.trajectory.certified.CertifiedTrajectory`,
+    a rigid robot's :class:`~kcplan.trajectory.certified.RigidTimedPath`; not written to
     JSON (its own file: their ``document()``)."""
 
     def verify(self, tolerance: float = 1e-6, padding: float | None = None) -> PathCheck:
@@ -457,12 +457,12 @@ def plan(
     trajectory : bool
         With a ``kc-*`` or ``ca-*`` planner (whose edges are certified), as
         ``PlanResult.trajectory``: an arm's path smoothed with certified blends and timed
-        within the joint limits (:func:`kcplan.planning.trajectory.certified_trajectory`);
+        within the joint limits (:func:`kcplan.trajectory.certified.certified_trajectory`);
         a rigid robot's timed edge by edge within translational and angular limits,
-        stopping at every corner (:func:`kcplan.planning.trajectory.timed_rigid_path`).
+        stopping at every corner (:func:`kcplan.trajectory.certified.timed_rigid_path`).
     velocity_limits, acceleration_limits : optional
-        The trajectory's limits (:func:`kcplan.planning.trajectory.joint_limits`, or
-        :func:`~kcplan.planning.trajectory.rigid_limits`).
+        The trajectory's limits (:func:`kcplan.trajectory.certified.joint_limits`, or
+        :func:`~kcplan.trajectory.certified.rigid_limits`).
     padding : float, optional
         The clearance every certified edge keeps from every obstacle and point, in the
         scenario's unit (default: the scenario's ``robot.padding``, else 0): the compiled

@@ -12,7 +12,7 @@ Each says what its states are (the OMPL space, how a state is read and written),
 checks a state (the kernel's compiled query, python-fcl, or Pinocchio for
 ``rrtconnect-pin``), which certifier decides an edge (a :class:`KCMotionValidator` for
 the ``kc-*`` and ``ca-*`` planners, chosen once by
-:func:`kcplan.planning.certifiers.certifier_for`), the kc planners' range, and how a
+:func:`kcplan.certification.certifiers.certifier_for`), the kc planners' range, and how a
 solved path is timed. :func:`setup_for` picks the implementation from the scenario.
 """
 
@@ -27,9 +27,9 @@ from ompl import geometric as og
 
 from kcplan.arm.scenario import ArmScenario
 from kcplan.arm.world import ArmWorld
+from kcplan.certification.arm_certifier import DEFAULT_ARM_CERTIFICATES
+from kcplan.certification.certifier import CERTIFICATE_SETS
 from kcplan.geometry.robot_model import RobotModel
-from kcplan.planning.arm_certifier import DEFAULT_ARM_CERTIFICATES
-from kcplan.planning.certifier import CERTIFICATE_SETS
 from kcplan.planning.lazy import LAZY_SCREEN_STEP, RIGID_SCREEN_STEP
 from kcplan.planning.names import ARM_RANGE, RIGID_RANGE
 from kcplan.planning.states import (
@@ -53,7 +53,7 @@ __all__ = ["ArmSetup", "ProblemSetup", "RigidSetup", "kernel_state_checker", "se
 ARM_CERTIFICATES_OF = {CERTIFICATE_SETS["ca"]: ("ball",)}
 """An arm's certificates for a planner's certificate set when the planner names none
 (``PlannerSpec.arm_certificates``): ``ca-*`` the clearance balls alone; any other set
-:data:`kcplan.planning.arm_certifier.DEFAULT_ARM_CERTIFICATES`."""
+:data:`kcplan.certification.arm_certifier.DEFAULT_ARM_CERTIFICATES`."""
 
 
 class ProblemSetup:
@@ -170,7 +170,7 @@ class RigidSetup(ProblemSetup):
         set_state(state, values, self.n)
 
     def timed(self, states: list, velocity_limits=None, acceleration_limits=None):
-        from kcplan.planning import trajectory
+        from kcplan.trajectory import certified as trajectory
 
         return trajectory.timed_rigid_path(states, self.n, velocity_limits, acceleration_limits)
 
@@ -180,8 +180,8 @@ class ArmSetup(ProblemSetup):
     collision query, compiled (``backend="kernel"``, on coal), on python-fcl, or with
     Pinocchio (``rrtconnect-pin``). For arms the ``ca-*`` planners certify with the
     chain's clearance balls, the other ``kc-*`` ones with the KC guards and the planes
-    as well (:mod:`kcplan.planning.arm_certifier`; inflation: the scenario's
-    ``robot.inflation``, else :data:`~kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`);
+    as well (:mod:`kcplan.certification.arm_certifier`; inflation: the scenario's
+    ``robot.inflation``, else :data:`~kcplan.certification.arm_certifier.DEFAULT_KC_INFLATION`);
     stock planners check states discretely, every ``joint_step`` radians where the
     planner sets one."""
 
@@ -242,7 +242,7 @@ class ArmSetup(ProblemSetup):
         set_joint_state(state, values)
 
     def timed(self, states: list, velocity_limits=None, acceleration_limits=None):
-        from kcplan.planning import trajectory
+        from kcplan.trajectory import certified as trajectory
 
         return trajectory.certified_trajectory(
             self.world, states, velocity_limits, acceleration_limits

@@ -10,7 +10,7 @@ Usable in any OMPL setup on SE(2) or SE(3)::
 and, for an arm, on the ``RealVectorStateSpace`` of its planning group (bounds: the
 joint limits), with ``robot`` a :class:`kcplan.arm.ArmModel` and ``world`` its
 :class:`kcplan.arm.ArmWorld` (edges decided by
-:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`).
+:class:`kcplan.certification.arm_certifier.ArmEdgeCertifier`).
 
 The validator keeps no reference to ``si`` (only to its state space): ``si`` holds the
 validator through a C++ ``shared_ptr`` that Python's collector cannot see, so a reference
@@ -29,7 +29,7 @@ Contract (OMPL's, as far as the Python binding allows):
   so planners that use it (the KPIECE family) treat a rejected edge as wholly invalid;
   none of kcplan's registered planners uses that form.
 * OMPL's own motion counters stay at zero for a Python validator; :attr:`counters` has
-  kcplan's (see :class:`kcplan.planning.certifier.EdgeCertifier`).
+  kcplan's (see :class:`kcplan.certification.certifier.EdgeCertifier`).
 * Not thread-safe; OMPL calls it from the thread that runs ``solve()``.
 """
 
@@ -41,8 +41,8 @@ from numpy.typing import ArrayLike
 from ompl import base as ob
 
 from kcplan.arm.world import ArmWorld
+from kcplan.certification.certifiers import certifier_for
 from kcplan.geometry.robot import Robot
-from kcplan.planning.certifiers import certifier_for
 from kcplan.planning.states import joint_reader, joint_state, state_pose
 
 __all__ = ["KCMotionValidator"]
@@ -65,16 +65,16 @@ class KCMotionValidator(ob.MotionValidator):
         ``free_regions`` for the ``region`` certificate) for flat poses
         ``[x, y, yaw]`` / ``[x, y, z, qx, qy, qz, qw]``.
     certificates : sequence of str, optional
-        The certificates (:func:`kcplan.planning.certifiers.certifier_for`).
+        The certificates (:func:`kcplan.certification.certifiers.certifier_for`).
     backend : {"kernel", "python"}, optional
         Who decides: the compiled kernel (on coal; the default where the world has one)
         or the Python reference (on python-fcl; the only choice for a world written in
         Python). Both decide every edge by the same steps; neither accepts an edge to a
         state that is not finite.
     **options
-        The options of the robot's kind, :data:`kcplan.planning.certifiers.RIGID_OPTIONS`
-        or :data:`~kcplan.planning.certifiers.ARM_OPTIONS`, described at
-        :func:`~kcplan.planning.certifiers.certifier_for`, which chooses the certifier;
+        The options of the robot's kind, :data:`kcplan.certification.certifiers.RIGID_OPTIONS`
+        or :data:`~kcplan.certification.certifiers.ARM_OPTIONS`, described at
+        :func:`~kcplan.certification.certifiers.certifier_for`, which chooses the certifier;
         an option of the other kind is one ``ValueError``.
     """
 
@@ -91,7 +91,7 @@ class KCMotionValidator(ob.MotionValidator):
         self.space = si.getStateSpace()  # not si itself: see the module docstring
         self.error: Exception | None = None
         self.certifier = certifier_for(robot, world, backend, certificates=certificates, **options)
-        """The certifier that decides (:data:`kcplan.planning.certifiers.Certifier`)."""
+        """The certifier that decides (:data:`kcplan.certification.certifiers.Certifier`)."""
         self.backend = self.certifier.backend
         """``"kernel"`` (compiled, on coal) or ``"python"`` (the reference certifier)."""
         self.n = self.certifier.n
@@ -132,7 +132,7 @@ class KCMotionValidator(ob.MotionValidator):
 
     @property
     def counters(self) -> dict:
-        """kcplan's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`) and, as
+        """kcplan's counters (:data:`kcplan.certification.certifier.COUNTER_NAMES`) and, as
         ``covered_NAME``, the edge parameter each certificate covered."""
         return self.certifier.counters | {
             f"covered_{k}": round(v, 6) for k, v in self.certifier.covered.items()

@@ -1,7 +1,11 @@
-"""Trajectories along joint-space paths: curves with blended corners
-(:mod:`kcplan.trajectory.curve`) and their time-optimal timing within joint limits
-(:mod:`kcplan.trajectory.timing`, TOPP-RA). Mathematics only: no OMPL, no FCL; the
-certificate of a curve lives in :mod:`kcplan.planning.smoothing`."""
+"""What is done to a path once found: curves, blends proved free, timing.
+
+The mathematics: joint-space curves with blended corners (:mod:`.curve`), their
+time-optimal timing within joint limits (:mod:`.timing`, TOPP-RA) and a rigid robot's
+edge-by-edge timing (:mod:`.rigid`), numpy and toppra only. The certified
+post-processing on top: an arm's corners replaced by blends proved free
+(:mod:`.smoothing`, with the arm certifier's bounds) and the certified, timed trajectory
+of a planned path (:mod:`.certified`). No OMPL, no FCL."""
 
 from kcplan.trajectory.curve import BlendedPath
 from kcplan.trajectory.timing import Trajectory, time_path

@@ -10,7 +10,7 @@ quadratic Bezier curve with control points ``a, c, b``:
 
 So ``B(t) - c = -(1 - t)^2 delta_i u1 + t^2 delta_i u2``: every point of the blend lies
 within ``delta_i max(|u1_j|, |u2_j|)`` of ``c`` in each joint ``j`` (as ``(1 - t)^2 + t^2 <=
-1``), which is what :mod:`kcplan.planning.smoothing` proves free. ``delta_i = 0`` keeps
+1``), which is what :mod:`kcplan.trajectory.smoothing` proves free. ``delta_i = 0`` keeps
 the corner (the curve then has a kink there and a trajectory stops at it).
 
 The curve is parametrised by ``s``: arc length (Euclidean, in joint space) on the

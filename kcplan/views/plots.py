@@ -639,7 +639,7 @@ def plot_joint_velocities(trajectory, path: str | os.PathLike, rate: float = 100
 
     Parameters
     ----------
-    trajectory : kcplan.planning.trajectory.CertifiedTrajectory or RigidTimedPath
+    trajectory : kcplan.trajectory.certified.CertifiedTrajectory or RigidTimedPath
     path : path-like
         The ``.png`` file, written atomically.
     rate : float

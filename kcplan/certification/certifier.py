@@ -1,7 +1,7 @@
 """The edge certifier: where certificates, guards, the guard cache and rejection meet.
 
 This module holds the one piece of logic that combines certificates
-(:mod:`kcplan.planning.certificates`) into a decision about an OMPL edge; it does not
+(:mod:`kcplan.certification.certificates`) into a decision about an OMPL edge; it does not
 import OMPL (:class:`kcplan.planning.validator.KCMotionValidator` is the thin adapter).
 """
 
@@ -13,17 +13,17 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from kcplan.geometry.pose import Edge, pose_size
-from kcplan.geometry.robot import Robot
-from kcplan.planning.certificates import (
+from kcplan.certification.certificates import (
     CERTIFICATE_NAMES,
     ClearanceBall,
     FreeRegionPlanes,
     KCPolytope,
 )
-from kcplan.planning.domain import PoseDomain
-from kcplan.planning.guard import Guard, GuardCache
-from kcplan.planning.ladder import GuardLadder
+from kcplan.certification.domain import PoseDomain
+from kcplan.certification.guard import Guard, GuardCache
+from kcplan.certification.ladder import GuardLadder
+from kcplan.geometry.pose import Edge, pose_size
+from kcplan.geometry.robot import Robot
 from kcplan.world.occupancy import CoreOccupancy
 
 __all__ = [
@@ -157,7 +157,7 @@ class EdgeCertifier:
     robot : Robot or array_like, optional
         Default ``world.robot``; semi-axes ``(n,)`` mean one body at the origin.
     certificates : sequence of str, optional
-        Names from :data:`kcplan.planning.certificates.CERTIFICATE_NAMES`; default
+        Names from :data:`kcplan.certification.certificates.CERTIFICATE_NAMES`; default
         ``CERTIFICATE_SETS["kc"]``, or ``("rotation",)`` for a world without region
         queries.
     ladder : GuardLadder, optional
@@ -186,12 +186,12 @@ class EdgeCertifier:
     cache : GuardCache, optional
         Shared with the state validity checker (see :meth:`state_valid`).
 
-    Poses outside :attr:`domain` (:class:`kcplan.planning.domain.PoseDomain`: not
+    Poses outside :attr:`domain` (:class:`kcplan.certification.domain.PoseDomain`: not
     finite, or outside the scenario's bounds by more than the scene's size) are never
     free and cost no query.
 
     Not thread-safe (the world reuses one FCL robot object). Its compiled twin, with the
-    same steps and counters, is :class:`kcplan.planning.kernel.KernelCertifier`.
+    same steps and counters, is :class:`kcplan.certification.kernel.KernelCertifier`.
     """
 
     backend = "python"
@@ -364,7 +364,7 @@ class EdgeCertifier:
     ) -> bool:
         """True when the whole edge ``pose1 -> pose2`` is proven free (see class docs); an
         edge with a pose outside :attr:`domain` (not finite, far outside the bounds; see
-        :class:`kcplan.planning.domain.PoseDomain`) is rejected (``rejected_end_state``).
+        :class:`kcplan.certification.domain.PoseDomain`) is rejected (``rejected_end_state``).
         ``probe=False`` skips the probes, which only reject early and prove nothing: for
         an edge a lazy planner has screened already (:meth:`screen`)."""
         c = self.counters

@@ -43,9 +43,9 @@ import math
 
 from numpy.typing import ArrayLike
 
+from kcplan.certification.guard import Guard
 from kcplan.geometry.pose import Edge
 from kcplan.geometry.robot import Robot
-from kcplan.planning.guard import Guard
 
 __all__ = ["ClearanceBall"]
 

@@ -3,12 +3,12 @@
 :func:`certifier_for` is the one place that turns a robot, its world and a caller's
 options into the object that decides edges:
 
-- a rigid robot (SE(2), SE(3)): :class:`~kcplan.planning.certifier.EdgeCertifier`
+- a rigid robot (SE(2), SE(3)): :class:`~kcplan.certification.certifier.EdgeCertifier`
   (``backend="python"``, on python-fcl) or its compiled twin
-  :class:`~kcplan.planning.kernel.KernelCertifier` (``"kernel"``, on coal);
+  :class:`~kcplan.certification.kernel.KernelCertifier` (``"kernel"``, on coal);
 - an arm, whose world is a :class:`kcplan.arm.ArmWorld`:
-  :class:`~kcplan.planning.arm_certifier.ArmEdgeCertifier` or its compiled twin
-  :class:`~kcplan.planning.kernel.KernelArmCertifier`.
+  :class:`~kcplan.certification.arm_certifier.ArmEdgeCertifier` or its compiled twin
+  :class:`~kcplan.certification.kernel.KernelArmCertifier`.
 
 The two twins of a kind decide every edge alike (the agreement tests hold them to it).
 Every certifier has ``backend``, ``n`` (the floats of a state), ``fallback``,
@@ -25,16 +25,16 @@ import math
 from collections.abc import Sequence
 
 from kcplan.arm.world import ArmWorld
-from kcplan.geometry.robot import Robot
-from kcplan.planning.arm_certifier import (
+from kcplan.certification.arm_certifier import (
     ARM_CERTIFICATES,
     DEFAULT_ARM_CERTIFICATES,
     DEFAULT_KC_INFLATION,
     ArmEdgeCertifier,
 )
-from kcplan.planning.certifier import DEFAULT_PROBES, EdgeCertifier
-from kcplan.planning.kernel import KernelArmCertifier, KernelCertifier
-from kcplan.planning.ladder import GuardLadder
+from kcplan.certification.certifier import DEFAULT_PROBES, EdgeCertifier
+from kcplan.certification.kernel import KernelArmCertifier, KernelCertifier
+from kcplan.certification.ladder import GuardLadder
+from kcplan.geometry.robot import Robot
 from kcplan.world.collision import CollisionWorld
 
 __all__ = ["ARM_OPTIONS", "RIGID_OPTIONS", "Certifier", "certifier_for"]
@@ -77,13 +77,13 @@ def certifier_for(robot, world, backend: str | None = None, **options) -> Certif
 
         certificates : sequence of str
             Default ``("region",)``, or ``("rotation",)`` when the world has no
-            ``free_regions`` (:data:`kcplan.planning.certifier.CERTIFICATE_SETS`).
+            ``free_regions`` (:data:`kcplan.certification.certifier.CERTIFICATE_SETS`).
         fallback : {"bisection", "discrete"}
             For the part of an edge the endpoint guards leave open: more guards (exact,
             the default) or sampling at OMPL's resolution.
         inflations : sequence of float
             The ``polytope`` certificate's guard ladder
-            (:data:`kcplan.planning.ladder.DEFAULT_LADDER`).
+            (:data:`kcplan.certification.ladder.DEFAULT_LADDER`).
         horizon : float
             Region horizon, length units (default the largest semi-axis).
         max_guards : int
@@ -93,7 +93,7 @@ def certifier_for(robot, world, backend: str | None = None, **options) -> Certif
             the world can tell).
         probes : int
             Collision queries on an edge before its guards
-            (:data:`kcplan.planning.certifier.DEFAULT_PROBES`; 0: none).
+            (:data:`kcplan.certification.certifier.DEFAULT_PROBES`; 0: none).
         learn_schedule : bool
             Test the occupancy grid's cells only while the grid pays (default True).
 
@@ -101,10 +101,10 @@ def certifier_for(robot, world, backend: str | None = None, **options) -> Certif
 
         certificates : sequence of str
             ``"ball"``, then any of ``"kc"`` and ``"region"``
-            (:data:`kcplan.planning.arm_certifier.ARM_CERTIFICATES`; default all).
+            (:data:`kcplan.certification.arm_certifier.ARM_CERTIFICATES`; default all).
         inflations : sequence of float
             One number: the KC guards' inflation ``eps``
-            (:data:`kcplan.planning.arm_certifier.DEFAULT_KC_INFLATION`).
+            (:data:`kcplan.certification.arm_certifier.DEFAULT_KC_INFLATION`).
         max_guards : int
             Guards per edge (default 256: joint-space edges are long).
         probes : int

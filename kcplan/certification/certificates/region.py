@@ -5,11 +5,11 @@ A region guard lists every obstacle piece within a horizon ``H`` of the robot at
 ``q(m)`` (:meth:`kcplan.world.CollisionWorld.free_region`): for a convex piece ``i`` a
 plane ``n_i . x <= c_i`` that contains the piece (its exact support function), with the
 robot's slack ``sigma_i(m) = n_i . t(m) - |A R(m)^T n_i| - c_i > 0``
-(:meth:`kcplan.planning.guard.Guard.from_region`), and the robot's clearance ``d_i`` to it.
+(:meth:`kcplan.certification.guard.Guard.from_region`), and the robot's clearance ``d_i`` to it.
 
 Along the edge ``t(s) = t(m) + (s - m) dt`` exactly, and ``|A R(s)^T n|`` changes by at
 most ``L |s - m| |w|`` with ``L = max(a) - min(a)`` (proof in
-:mod:`kcplan.planning.certificates.ball`), so
+:mod:`kcplan.certification.certificates.ball`), so
 
     sigma_i(s) >= sigma_i(m) + (s - m) (n_i . dt) - |s - m| L |w|,
 
@@ -59,9 +59,9 @@ import math
 
 from numpy.typing import ArrayLike
 
+from kcplan.certification.guard import Guard
 from kcplan.geometry.pose import Edge
 from kcplan.geometry.robot import Robot
-from kcplan.planning.guard import Guard
 
 __all__ = ["FreeRegionPlanes"]
 

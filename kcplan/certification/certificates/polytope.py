@@ -10,15 +10,15 @@ of ``P_eps`` along ``+-direction(m)`` (:meth:`GuardLadder.reach`). The ladder ho
 polytopes for a few inflations; the largest one the clearance allows is used.
 
 The polytope is the paper's bound for one ellipsoid ``E_a`` centred at the robot's
-origin; for a robot of several bodies :class:`kcplan.planning.certifier.EdgeCertifier`
+origin; for a robot of several bodies :class:`kcplan.certification.certifier.EdgeCertifier`
 refuses it.
 """
 
 from __future__ import annotations
 
+from kcplan.certification.guard import Guard
+from kcplan.certification.ladder import GuardLadder
 from kcplan.geometry.pose import Edge
-from kcplan.planning.guard import Guard
-from kcplan.planning.ladder import GuardLadder
 
 __all__ = ["KCPolytope"]
 

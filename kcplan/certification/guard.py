@@ -1,6 +1,6 @@
 """A guard: what one query at a robot pose proves about the space around it.
 
-Every certificate (:mod:`kcplan.planning.certificates`) reads a guard and nothing else
+Every certificate (:mod:`kcplan.certification.certificates`) reads a guard and nothing else
 from the world, so a guard measured once at a state the planner keeps can certify every
 later edge from that state with no new query (:class:`GuardCache`).
 """

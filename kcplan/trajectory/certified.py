@@ -1,12 +1,12 @@
 """Certified, timed trajectories. An arm's: its path smoothed by blends proved free
-(:mod:`kcplan.planning.smoothing`), then timed by TOPP-RA within the joints' velocity and
+(:mod:`kcplan.trajectory.smoothing`), then timed by TOPP-RA within the joints' velocity and
 acceleration limits (:mod:`kcplan.trajectory.timing`). A rigid robot's: its certified
 edges timed one by one within translational and angular limits, stopping at every
 corner (:mod:`kcplan.trajectory.rigid`; no blends).
 
 The trajectory follows the certified curve exactly (timing only chooses the speed along
 it), so every configuration it passes through is proved free: the straight pieces by the
-planner's certified edges, the blends by :func:`kcplan.planning.smoothing.certify_blends`.
+planner's certified edges, the blends by :func:`kcplan.trajectory.smoothing.certify_blends`.
 Its file (:meth:`CertifiedTrajectory.document`) carries the curve itself (``curve``: the
 waypoints and each corner's blend), so that ``kcplan verify`` can check the continuous
 curve on the meshes and every sample against it.
@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from kcplan.planning.smoothing import BlendCertificate, smooth_path
 from kcplan.trajectory.curve import BlendedPath
 from kcplan.trajectory.rigid import (
     DEFAULT_RIGID_ACCELERATIONS,
@@ -30,6 +29,7 @@ from kcplan.trajectory.rigid import (
     RigidTrajectory,
     time_rigid_path,
 )
+from kcplan.trajectory.smoothing import BlendCertificate, smooth_path
 from kcplan.trajectory.timing import Trajectory, time_path
 
 __all__ = [
@@ -174,7 +174,7 @@ class CertifiedTrajectory:
                 "edges": self.edges,
                 "edge_certificate": "the planner's motion validator (kcplan.planning)",
                 "blend_certificate": "guards along each blend, chain bound "
-                "(kcplan.planning.smoothing)",
+                "(kcplan.trajectory.smoothing)",
                 **self.certificate.summary(),
                 "seconds": self.seconds,
             },

@@ -7,7 +7,7 @@ plus)``: with the guard measured at the edge's pose ``q(m)``, every pose ``q(s)`
 the guard, whose clearances never overestimate and whose planes are exact. A certificate
 that cannot prove anything returns ``(0, 0)``. The union of what several certificates
 prove from one guard is an interval around ``m``, so a combination takes the largest
-reach on each side (:class:`kcplan.planning.certifier.EdgeCertifier`).
+reach on each side (:class:`kcplan.certification.certifier.EdgeCertifier`).
 
 ============== ======================================= =================================
 name           rule                                    needs
@@ -28,11 +28,11 @@ lever``        offset bodies (the ablation)
 ============== ======================================= =================================
 """
 
-from kcplan.planning.certificates.ball import ClearanceBall
-from kcplan.planning.certificates.polytope import KCPolytope
-from kcplan.planning.certificates.region import FreeRegionPlanes
+from kcplan.certification.certificates.ball import ClearanceBall
+from kcplan.certification.certificates.polytope import KCPolytope
+from kcplan.certification.certificates.region import FreeRegionPlanes
 
 __all__ = ["CERTIFICATE_NAMES", "ClearanceBall", "KCPolytope", "FreeRegionPlanes"]
 
 CERTIFICATE_NAMES = ("ball", "rotation", "polytope", "region", "region-lever")
-"""Names accepted by :class:`kcplan.planning.certifier.EdgeCertifier`."""
+"""Names accepted by :class:`kcplan.certification.certifier.EdgeCertifier`."""

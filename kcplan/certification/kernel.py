@@ -2,11 +2,11 @@
 
 :class:`KernelCertifier` runs :class:`kcplan._kernel.EdgeCertifier` (C++, on coal) on the
 kernel twin of a :class:`kcplan.world.CollisionWorld` and answers exactly what
-:class:`kcplan.planning.certifier.EdgeCertifier` answers: ``check``, ``state_valid``,
+:class:`kcplan.certification.certifier.EdgeCertifier` answers: ``check``, ``state_valid``,
 ``counters`` and ``covered`` under the same names. It holds no logic of its own; the
 decision is made in ``kcplan/_kernel/certifier.cpp``, whose Python twin is
-:mod:`kcplan.planning.certifier`. :class:`KernelArmCertifier` does the same for arms
-(``kcplan/_kernel/arm_certifier.cpp``, twin :mod:`kcplan.planning.arm_certifier`).
+:mod:`kcplan.certification.certifier`. :class:`KernelArmCertifier` does the same for arms
+(``kcplan/_kernel/arm_certifier.cpp``, twin :mod:`kcplan.certification.arm_certifier`).
 """
 
 from __future__ import annotations
@@ -18,15 +18,15 @@ from numpy.typing import ArrayLike
 
 from kcplan._kernel import ArmCertifier as _CompiledArmCertifier
 from kcplan._kernel import EdgeCertifier as _CompiledCertifier
-from kcplan.planning.arm_certifier import PROBE_STEP, arm_certificates
-from kcplan.planning.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
-from kcplan.planning.ladder import GuardLadder
+from kcplan.certification.arm_certifier import PROBE_STEP, arm_certificates
+from kcplan.certification.certifier import CERTIFICATE_SETS, DEFAULT_PROBES, check_certificates
+from kcplan.certification.ladder import GuardLadder
 
 __all__ = ["KernelArmCertifier", "KernelCertifier"]
 
 
 class KernelCertifier:
-    """:class:`kcplan.planning.certifier.EdgeCertifier`'s decisions, made in C++.
+    """:class:`kcplan.certification.certifier.EdgeCertifier`'s decisions, made in C++.
 
     Parameters
     ----------
@@ -34,12 +34,12 @@ class KernelCertifier:
         Its :attr:`~kcplan.world.CollisionWorld.kernel` is used (built on first use); the
         certifier's queries show in ``world.counters``.
     certificates, ladder, horizon, fallback, max_guards, sweep_test, occupancy, probes
-        As for :class:`~kcplan.planning.certifier.EdgeCertifier` (``sweep_test`` and
+        As for :class:`~kcplan.certification.certifier.EdgeCertifier` (``sweep_test`` and
         ``occupancy`` default to on; both need a robot core).
     cache_entries : int
         Bound of the guard cache (guards, and as many validity marks).
     learn_schedule : bool
-        As for :class:`~kcplan.planning.certifier.EdgeCertifier`.
+        As for :class:`~kcplan.certification.certifier.EdgeCertifier`.
 
     Notes
     -----
@@ -113,7 +113,7 @@ class KernelCertifier:
 
     @property
     def counters(self) -> dict[str, int]:
-        """:data:`kcplan.planning.certifier.COUNTER_NAMES`, counted in C++."""
+        """:data:`kcplan.certification.certifier.COUNTER_NAMES`, counted in C++."""
         return self._kernel.counters
 
     @property
@@ -130,7 +130,7 @@ class KernelCertifier:
         self, pose1: ArrayLike, pose2: ArrayLike, resolution: float = 0.01, probe: bool = True
     ) -> bool:
         """True when the whole edge ``pose1 -> pose2`` is proven free (``probe``: as
-        :meth:`kcplan.planning.certifier.EdgeCertifier.check`)."""
+        :meth:`kcplan.certification.certifier.EdgeCertifier.check`)."""
         return self._kernel.check(_flat(pose1), _flat(pose2), float(resolution), bool(probe))
 
     def state_valid(self, pose: ArrayLike) -> bool:
@@ -139,13 +139,13 @@ class KernelCertifier:
 
     def screen(self, pose1: ArrayLike, pose2: ArrayLike, step: float) -> bool:
         """The edge's cheap tests and probes only, not a proof
-        (:meth:`kcplan.planning.certifier.EdgeCertifier.screen`)."""
+        (:meth:`kcplan.certification.certifier.EdgeCertifier.screen`)."""
         return self._kernel.screen(_flat(pose1), _flat(pose2), float(step))
 
     def measure(self, pose: ArrayLike) -> tuple[float, list]:
         """One guard query at ``pose`` (not cached): ``(clearance, bodies)`` with, per
         body, ``(clearance, planes, horizon)`` and planes ``(nx, ny, nz, slack,
-        clearance)`` as in :class:`kcplan.planning.guard.BodyGuard`."""
+        clearance)`` as in :class:`kcplan.certification.guard.BodyGuard`."""
         return self._kernel.measure(_flat(pose))
 
 
@@ -154,7 +154,7 @@ def _flat(pose: ArrayLike) -> list[float]:
 
 
 class KernelArmCertifier:
-    """:class:`kcplan.planning.arm_certifier.ArmEdgeCertifier`'s decisions, made in C++.
+    """:class:`kcplan.certification.arm_certifier.ArmEdgeCertifier`'s decisions, made in C++.
 
     Parameters
     ----------
@@ -162,7 +162,7 @@ class KernelArmCertifier:
         Its :attr:`~kcplan.arm.ArmWorld.kernel` is used (built on first use); the
         certifier's queries show in ``world.counters``.
     max_guards, cache_entries, probes
-        As for :class:`~kcplan.planning.arm_certifier.ArmEdgeCertifier`.
+        As for :class:`~kcplan.certification.arm_certifier.ArmEdgeCertifier`.
     part_balls : bool
         Decide a group of self pairs (two links' bodies) at once when balls around the
         links' bodies show that none of them can limit a guard's radius, and ask a pair's
@@ -170,12 +170,12 @@ class KernelArmCertifier:
         the decisions, are those without it). False: every pair at every guard.
     first_order : bool
         Bound the bodies' motion by their twist at each guard as well
-        (:mod:`kcplan.planning.arm_certifier`); False is the ablation.
+        (:mod:`kcplan.certification.arm_certifier`); False is the ablation.
     kc_inflation : float
-        The KC certificate's ``eps`` (:mod:`kcplan.planning.arm_certifier`); 0: the
+        The KC certificate's ``eps`` (:mod:`kcplan.certification.arm_certifier`); 0: the
         clearance ball alone (the ``ca`` ablation).
     planes : bool
-        The plane certificate (with ``first_order``; :mod:`kcplan.planning.arm_certifier`):
+        The plane certificate (with ``first_order``; :mod:`kcplan.certification.arm_certifier`):
         a body stays free of an obstacle while it does not cross the slab between them.
         False is the ablation.
 
@@ -218,7 +218,7 @@ class KernelArmCertifier:
     ) -> bool:
         """True when the whole edge is proven free (``resolution`` is unused: arms have
         no discrete fallback; ``probe``: as
-        :meth:`kcplan.planning.arm_certifier.ArmEdgeCertifier.check`)."""
+        :meth:`kcplan.certification.arm_certifier.ArmEdgeCertifier.check`)."""
         return self.compiled.check(_joints(state1), _joints(state2), bool(probe))
 
     def state_valid(self, state: ArrayLike) -> bool:
@@ -227,7 +227,7 @@ class KernelArmCertifier:
 
     def screen(self, state1: ArrayLike, state2: ArrayLike, step: float = PROBE_STEP) -> bool:
         """The edge's probes only, not a proof
-        (:meth:`kcplan.planning.arm_certifier.ArmEdgeCertifier.screen`)."""
+        (:meth:`kcplan.certification.arm_certifier.ArmEdgeCertifier.screen`)."""
         return self.compiled.screen(_joints(state1), _joints(state2), float(step))
 
     @property

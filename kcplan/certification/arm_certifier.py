@@ -43,7 +43,7 @@ query (:meth:`kcplan.arm.ArmWorld.grown_clear`). At ``s`` the body is ``c(s) + R
 diag(a) B``; in the guard's frame its centre is displaced by ``d = R_g^T (c(s) - c_g)``
 and it is turned by ``R_g^T R(s)``, by an angle ``theta``. For a unit ``n`` its support
 function is ``n . d + |diag(a) R(s)^T R_g n|``, and the turn moves it by at most ``(a_max -
-a_min) theta`` (:mod:`kcplan.planning.certificates.ball`: an ellipsoid's support function
+a_min) theta`` (:mod:`kcplan.certification.certificates.ball`: an ellipsoid's support function
 turns at most ``a_max - a_min`` per radian), while ``n . d <= |diag(a) n| |diag(a)^-1 d|``
 and ``|diag(a) n| >= a_min``. So the body lies inside ``G``, whose support function is
 ``(1 + eps) |diag(a) n|``, as long as
@@ -109,8 +109,8 @@ from kcplan.arm.bounds import (
     twists,
 )
 from kcplan.arm.kinematics import body_frames
-from kcplan.planning.certifier import COUNTER_NAMES, advance, probe_points
-from kcplan.planning.guard import GuardCache
+from kcplan.certification.certifier import COUNTER_NAMES, advance, probe_points
+from kcplan.certification.guard import GuardCache
 
 __all__ = [
     "ARM_CERTIFICATES",
@@ -130,7 +130,7 @@ ARM_COUNTER_NAMES = tuple(
     if name not in ("rejected_sweep", "rejected_occupancy")
     and name not in ("occupancy_rejections", "occupancy_queries")
 )
-"""The rigid certifier's counters (:data:`kcplan.planning.certifier.COUNTER_NAMES`), with
+"""The rigid certifier's counters (:data:`kcplan.certification.certifier.COUNTER_NAMES`), with
 the same meanings, less those of the steps arms do not have (core sweep, occupancy
 grid)."""
 
@@ -169,7 +169,7 @@ class ArmGuard:
     @property
     def clearance(self) -> float:
         """The smallest of them (``inf`` with neither); > 0: the state is free. This is
-        what :class:`kcplan.planning.guard.GuardCache` reads a state's validity from."""
+        what :class:`kcplan.certification.guard.GuardCache` reads a state's validity from."""
         return float(min(self.scene.min(initial=math.inf), self.pairs.min(initial=math.inf)))
 
 
@@ -194,7 +194,7 @@ class ArmEdgeCertifier:
         Probe the stretch left open before the guards (module docstring).
     cache_entries : int
         States whose validity and guard are remembered (the rigid certifier's
-        :class:`kcplan.planning.guard.GuardCache`: the oldest are dropped first).
+        :class:`kcplan.certification.guard.GuardCache`: the oldest are dropped first).
     first_order : bool
         Bound the bodies' motion by their twist at the guard as well (module docstring);
         False: the levers alone (the ablation).

@@ -1,6 +1,6 @@
 """A ladder of the paper's convex lower bounds ``P_eps`` of one robot, cached on disk.
 
-The KC-polytope certificate (:mod:`kcplan.planning.certificates.polytope`) picks the
+The KC-polytope certificate (:mod:`kcplan.certification.certificates.polytope`) picks the
 largest inflation a guard's clearance allows and asks the ladder how far ``P_eps``
 reaches along the edge's KC direction (its gauge: one matrix-vector product).
 """

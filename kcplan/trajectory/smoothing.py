@@ -17,7 +17,7 @@ the same with its own terms. Both bounds have nonnegative coefficients in ``|D_j
 with ``|D_j| <= delta m_j`` they are at most ``delta v`` and ``delta A(m) + delta^2 Q(m) /
 2``, ``v``, ``A(m)``, ``Q(m)`` the terms of the "edge" ``dq = m``. So every body and pair
 stays clear while ``delta`` is below the radius ``r`` that the straight-edge certifier's
-ball would give this guard for ``dq = m`` (:func:`kcplan.planning.arm_certifier.
+ball would give this guard for ``dq = m`` (:func:`kcplan.certification.arm_certifier.
 stretch_radii`: ``max(d / v, t)`` with ``A t + Q t^2 / 2 = d``, the smallest over bodies and
 pairs), and the blend, whose points all lie in that set, is free. The straight pieces
 left between blends are parts of certified edges. (The twist and KC bounds of the edge
@@ -26,7 +26,7 @@ certifier need a straight motion in one signed direction and are not used.)
 *Larger blends, along the curve.* A corner of a shortened path is often close to an
 obstacle, which holds that one guard's radius to a few milliradians, while a blend many
 times larger is free. So the curve itself is certified first, by conservative advancement
-(:func:`kcplan.planning.certifier.advance`) in its parameter ``t``: ``B'(t) = 2 delta ((1 -
+(:func:`kcplan.certification.certifier.advance`) in its parameter ``t``: ``B'(t) = 2 delta ((1 -
 t) u1 + t u2)``, so ``|B'_j(t)| <= b_j = 2 delta m_j`` along the whole blend, and the proof
 above holds for the curve with ``b`` in place of ``|dq|`` (the chain's bounds integrate
 ``|dq_j/dt|``, which any curve in the joint box has; :mod:`kcplan.arm.bounds`): a guard at
@@ -54,8 +54,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from kcplan._kernel import ArmCertifier
 from kcplan.arm.bounds import carries, point_speeds, relative_speeds
-from kcplan.planning.arm_certifier import stretch_radii
-from kcplan.planning.certifier import advance
+from kcplan.certification.arm_certifier import stretch_radii
+from kcplan.certification.certifier import advance
 from kcplan.trajectory.curve import TURN_FLOOR, BlendedPath, corner_directions
 
 __all__ = ["BLEND_SHARE", "BlendCertificate", "certify_blends", "smooth_path"]
