@@ -7,11 +7,17 @@ kind) are the thin OMPL adapters. :mod:`.native` runs an arm's planning loop in 
 compiled kernel instead (``kc-rrtconnect-native``), with no OMPL or Python per edge.
 """
 
-from kcplan.certification.certifier import CERTIFICATE_SETS, EdgeCertifier
-from kcplan.certification.guard import Guard, GuardCache
-from kcplan.certification.ladder import DEFAULT_LADDER, GuardLadder
+from kcplan.certification import (
+    CERTIFICATE_SETS,
+    DEFAULT_LADDER,
+    EdgeCertifier,
+    Guard,
+    GuardCache,
+    GuardLadder,
+)
 from kcplan.planning.validator import KCMotionValidator
 
+# the certification's names, where they were before it had a package of its own
 __all__ = [
     "CERTIFICATE_SETS",
     "DEFAULT_LADDER",
