@@ -165,6 +165,11 @@ NB_MODULE(_core, m) {
       .def("finalize", &kcplan::World::finalize)
       .def_prop_rw("padding", &kcplan::World::padding, &kcplan::World::set_padding,
                    "Metres every body keeps from every obstacle (MoveIt's link padding)")
+      .def("set_body_padding", &kcplan::World::set_body_padding, "k"_a, "padding"_a,
+           "Metres body k keeps from every obstacle instead of `padding` (MoveIt's per-link "
+           "padding); setting `padding` again undoes it")
+      .def("padding_of", &kcplan::World::padding_of, "shape"_a,
+           "The padding shape k keeps (a ball standing for several bodies: the largest)")
       .def_prop_ro("n_objects", &kcplan::World::n_objects)
       .def_prop_ro("dimension", [](const kcplan::World& w) { return w.robot().dimension(); })
       .def_prop_ro("atol", &kcplan::World::atol)

@@ -425,6 +425,19 @@ void World::set_padding(double padding) {
   if (!(padding >= 0.0) || !std::isfinite(padding))
     throw std::invalid_argument("padding: expected a finite number >= 0");
   padding_ = padding;
+  body_padding_.clear();
+  max_padding_ = padding;
+}
+
+void World::set_body_padding(std::size_t k, double padding) {
+  if (k >= bodies_.size())
+    throw std::invalid_argument("body padding: expected a body index below " +
+                                std::to_string(bodies_.size()));
+  if (!(padding >= 0.0) || !std::isfinite(padding))
+    throw std::invalid_argument("body padding: expected a finite number >= 0");
+  if (body_padding_.empty()) body_padding_.assign(bodies_.size(), padding_);
+  body_padding_[k] = padding;
+  max_padding_ = *std::max_element(body_padding_.begin(), body_padding_.end());
 }
 
 void World::finalize() {
@@ -475,11 +488,11 @@ World::WarmStart& World::warm(std::size_t shape, const coal::CollisionObject& ob
 }
 
 bool World::collides(coal::CollisionObject& object, std::size_t shape) {
-  if (padding_ > 0.0) {  // nearer than the padding (beyond the allowance): a contact
-    const double cap = 2.0 * raw_cap(0.0);
+  if (padding_of(shape) > 0.0) {  // nearer than the padding (beyond the allowance): a contact
+    const double cap = 2.0 * raw_cap(0.0, shape);
     DistanceNear near(this, &object, shape, cap);
     manager_->distance(&object, &near);
-    return near.best < cap && !(clear(near.best) > 0.0);
+    return near.best < cap && !(clear(near.best, shape) > 0.0);
   }
   CollideNear near(this, &object, shape);
   manager_->collide(&object, &near);
@@ -560,7 +573,7 @@ void World::safe_body_clearances(const Pose& pose, double* out) {
 void World::bodies_safe_clearances(double* out, const double* caps) {
   if (caps == nullptr) {
     bodies_distances(out);
-    for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = clear(out[k]);
+    for (std::size_t k = 0; k < bodies_.size(); ++k) out[k] = clear(out[k], k);
     return;
   }
   ++counters.distance_queries;
@@ -597,10 +610,10 @@ bool World::grown_body_clear(std::size_t k, const coal::Transform3s& frame, doub
   count_body(k);
   // clear when its distance is certainly positive: past the smallest cap that says so
   const double cap = std::numeric_limits<double>::min();
-  const double raw = raw_cap(cap);
+  const double raw = raw_cap(cap, k);
   DistanceNear near(this, &grown, k, raw);  // body k's warm starts: a shape like it
   manager_->distance(&grown, &near);
-  return near.best >= raw || clear(near.best) > 0.0;
+  return near.best >= raw || clear(near.best, k) > 0.0;
 }
 
 double World::capped_clearance(std::size_t k, double cap) {
@@ -608,10 +621,10 @@ double World::capped_clearance(std::size_t k, double cap) {
   count_body(k);
   // a raw distance of at least (cap + atol) / (1 - rtol) is certainly at least cap
   const double raw =
-      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap) : std::numeric_limits<double>::infinity();
+      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap, k) : std::numeric_limits<double>::infinity();
   DistanceNear near(this, bodies_[k].get(), k, raw);
   manager_->distance(bodies_[k].get(), &near);
-  return near.best >= raw ? cap : clear(near.best);
+  return near.best >= raw ? cap : clear(near.best, k);
 }
 
 bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegion>& out) {
@@ -631,7 +644,7 @@ bool World::free_regions(const Pose& pose, double horizon, std::vector<FreeRegio
     }
     if (region.planes.empty()) {  // open space: the clearance to everything is the better horizon
       ++counters.distance_queries;
-      region.horizon = std::max(horizon, clear(distance(*bodies_[k], k)));
+      region.horizon = std::max(horizon, clear(distance(*bodies_[k], k), k));
     }
   }
   return true;
@@ -645,7 +658,10 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
   count_body(k);
   coal::CollisionObject& body = *bodies_[k];
   // the broad-phase box of body k: contains every point within `horizon` of the body
-  const double side = 2.0 * (robot_.bodies()[k].a_max + horizon);
+  // beyond its padding (an obstacle outside it is farther than horizon + padding, so its
+  // padded clearance exceeds the horizon)
+  const double pad = padding_of(k);
+  const double side = 2.0 * (robot_.bodies()[k].a_max + horizon + pad);
   const double height = dimension_ == 3 ? side : 4.0 * half_height_;  // every prism
   if (!horizon_boxes_[k]) {
     horizon_boxes_[k] =
@@ -675,11 +691,11 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
     if (primitive_slabs && primitives_[index].kind != Primitive::kNone) {
       bool exact;
       Vec3s n;
-      const double gap = primitives_[index].separation(shape, exact, n) - padding_;
+      const double gap = primitives_[index].separation(shape, exact, n) - pad;
       if (gap > 0.0) {  // the (padded) obstacle lies in {n . x <= support(n) + padding}
         Plane plane;
         for (int i = 0; i < 3; ++i) plane.n[i] = n[i];
-        plane.offset = primitives_[index].support(n) + padding_;
+        plane.offset = primitives_[index].support(n) + pad;
         plane.clearance = gap;
         region.planes.push_back(plane);
         continue;
@@ -689,30 +705,30 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
       // measured up to the horizon only; its plane holds the balls that meet the
       // horizon's box (every other ball is farther than the horizon)
       Vec3s towards;
-      const double d = cloud->distance(body, raw_cap(horizon), &towards);
-      if (!(d > 0.0) || (padding_ > 0.0 && !(clear(d) > 0.0))) {
+      const double d = cloud->distance(body, raw_cap(horizon, k), &towards);
+      if (!(d > 0.0) || (pad > 0.0 && !(clear(d, k) > 0.0))) {
         region.planes.clear(), region.horizon = 0.0;
         return false;
       }
       Plane plane;
-      plane.clearance = clear(d);
+      plane.clearance = clear(d, k);
       plane.n[0] = plane.n[1] = plane.n[2] = 0.0;
       plane.offset = std::numeric_limits<double>::infinity();
       if (dimension_ == 3 && towards.squaredNorm() > 0.0) {
         for (int i = 0; i < 3; ++i) plane.n[i] = towards[i];
         // the padded balls lie in {n . x <= support + padding}
-        plane.offset = cloud->support(box.getAABB(), towards) + padding_;
+        plane.offset = cloud->support(box.getAABB(), towards) + pad;
       }
       region.planes.push_back(plane);
       continue;
     }
     const double d = pair_distance(body, k, *obstacle, request, result);
-    if (!(d > 0.0) || (padding_ > 0.0 && !(clear(d) > 0.0))) {
+    if (!(d > 0.0) || (pad > 0.0 && !(clear(d, k) > 0.0))) {
       region.planes.clear(), region.horizon = 0.0;
       return false;
     }
     Plane plane;
-    plane.clearance = clear(d);
+    plane.clearance = clear(d, k);
     const Support& support = supports_[index];
     double v[3] = {0.0, 0.0, 0.0};
     if (support.kind != Support::kNone) {  // a mesh's distance may come without points
@@ -726,7 +742,7 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
     } else {
       for (int i = 0; i < 3; ++i) plane.n[i] = v[i] / length;
       // exact: a wrong direction only weakens the plane; the padding lies beyond it
-      plane.offset = support(plane.n) + padding_;
+      plane.offset = support(plane.n) + pad;
     }
     region.planes.push_back(plane);
   }
@@ -776,10 +792,11 @@ double World::ball_safe_clearance(const std::array<double, 3>& centre, double ra
   // as capped_clearance: a raw distance of at least (cap + atol) / (1 - rtol) is certainly
   // at least cap
   const double raw =
-      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap) : std::numeric_limits<double>::infinity();
+      cap < std::numeric_limits<double>::infinity() ? raw_cap(cap, core_shape())
+                                                    : std::numeric_limits<double>::infinity();
   DistanceNear near(this, &ball, core_shape(), raw);
   manager_->distance(&ball, &near);
-  return near.best >= raw ? cap : clear(near.best);
+  return near.best >= raw ? cap : clear(near.best, core_shape());
 }
 
 bool World::sweep_core_collides(const std::array<double, 3>& a, const std::array<double, 3>& b,

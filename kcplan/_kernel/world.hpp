@@ -162,18 +162,32 @@ class World {
   /// A distance reduced by the error allowance, d (1 - rtol) - atol, at least 0: what a
   /// coal distance certainly is (never an overestimate).
   double safe(double d) const { return std::max(d * (1.0 - rtol_) - atol_, 0.0); }
-  /// What an obstacle's coal distance certainly leaves beyond the padding: safe(d) less
-  /// the padding, at least 0. Every clearance of a body to the obstacles is this.
-  double clear(double d) const {
-    return std::max(d * (1.0 - rtol_) - atol_ - padding_, 0.0);
+  /// The padding that shape `shape` keeps: body k's own (set_body_padding) for a body,
+  /// the largest of every body's for a shape past them (a ball or a sweep standing for
+  /// several bodies).
+  double padding_of(std::size_t shape) const {
+    if (body_padding_.empty()) return padding_;
+    return shape < body_padding_.size() ? body_padding_[shape] : max_padding_;
   }
-  /// The raw coal distance past which a body is certainly clear by `cap` beyond the
-  /// padding: clear(d) >= cap for every d at least this.
-  double raw_cap(double cap) const { return (cap + atol_ + padding_) / (1.0 - rtol_); }
+  /// What an obstacle's coal distance to shape `shape` certainly leaves beyond its
+  /// padding: safe(d) less the padding, at least 0. Every clearance of a body to the
+  /// obstacles is this.
+  double clear(double d, std::size_t shape) const {
+    return std::max(d * (1.0 - rtol_) - atol_ - padding_of(shape), 0.0);
+  }
+  /// The raw coal distance past which shape `shape` is certainly clear by `cap` beyond
+  /// its padding: clear(d, shape) >= cap for every d at least this.
+  double raw_cap(double cap, std::size_t shape) const {
+    return (cap + atol_ + padding_of(shape)) / (1.0 - rtol_);
+  }
   /// Keep every body at least `padding` (>= 0, finite; length units) from every obstacle:
   /// clearances are reduced by it and a body nearer than it is in collision (MoveIt's
-  /// link padding; self pairs are not padded). 0 by default.
+  /// link padding; self pairs are not padded). 0 by default. Undoes set_body_padding.
   void set_padding(double padding);
+  /// Keep body k at least `padding` (>= 0, finite) from every obstacle instead of
+  /// padding() (MoveIt's per-link padding); balls and sweeps that stand for several
+  /// bodies keep the largest padding of all.
+  void set_body_padding(std::size_t k, double padding);
   double padding() const { return padding_; }
 
   /// Whether body k grown about its centre by `scale` (its semi-axes times scale >= 1)
@@ -292,6 +306,8 @@ class World {
   int dimension_;
   double half_height_, rtol_, atol_;
   double padding_ = 0.0;
+  std::vector<double> body_padding_;  // per body; empty: padding_ for every one
+  double max_padding_ = 0.0;          // the largest of body_padding_
   std::vector<std::unique_ptr<coal::CollisionObject>> objects_;
   std::vector<Support> supports_;
   std::vector<Primitive> primitives_;  // per obstacle; kNone: not a box, ball or cylinder

@@ -40,6 +40,7 @@ the rigid format's one-line errors (:class:`kcplan.world.fields.ScenarioError`).
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -81,6 +82,9 @@ class ArmScenario:
     """The clearance (metres) every certified path keeps from every obstacle and point
     (``robot.padding``; MoveIt's link padding, attached parts included; self pairs are not
     padded)."""
+    link_padding: Mapping[str, float] = field(default_factory=dict)
+    """The clearance (metres) that a link, or an attached part by its name, keeps instead
+    of :attr:`padding` (``robot.link_padding``; MoveIt's per-link padding)."""
     dimension = 3
 
     @property
@@ -137,7 +141,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     spec = r.mapping(
         top["robot"], "robot", (),
         ("urdf", "example", "joints", "srdf", "fixed", "package_dirs", "representation",
-         "bodies_per_link", "max_offset", "inflation", "padding"),
+         "bodies_per_link", "max_offset", "inflation", "padding", "link_padding"),
     )  # fmt: skip
     if ("urdf" in spec) == ("example" in spec):
         r.fail("robot", "a urdf (a file) or an example (a robot of example-robot-data)",
@@ -222,8 +226,27 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
     allowed = _allowed(r, top.get("allowed") or [])
     return ArmScenario(
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
-        description, source, directory, read_padding(r, spec),
+        description, source, directory, read_padding(r, spec), _link_padding(r, spec, arm),
     )  # fmt: skip
+
+
+def _link_padding(r: FieldReader, spec: dict, arm: ArmModel) -> dict[str, float]:
+    """``robot.link_padding``: a mapping of a link's (or an attached part's) name to the
+    metres (>= 0) its bodies keep from obstacles instead of ``robot.padding``."""
+    value = spec.get("link_padding") or {}
+    if not isinstance(value, dict):
+        r.fail("robot.link_padding", "a mapping of link names to metres", value)
+    links = {b.link for b in arm.bodies}
+    out = {}
+    for name, metres in value.items():
+        where = f"robot.link_padding.{name}"
+        if name not in links:
+            r.fail(where, f"a link with bodies or an attached part ({', '.join(sorted(links))})",
+                   name)  # fmt: skip
+        out[name] = r.number(metres, where)
+        if out[name] < 0:
+            r.fail(where, "a clearance of at least 0", metres)
+    return out
 
 
 def links_mask(arm: ArmModel, state: NDArray, points: NDArray, padding: float) -> NDArray:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Collection, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import fcl
@@ -146,6 +146,9 @@ class ArmMeshChecker:
         nearer than ``padding + tolerance`` to the scene is a collision (``kcplan verify
         --padding``); the advancement then steps by the distance less the padding, so
         the padding is checked without gaps too.
+    link_padding : mapping of str to float, optional
+        Metres that a link (or an attached part, by its name) keeps instead of
+        ``padding`` (``robot.link_padding``).
 
     Notes
     -----
@@ -165,6 +168,7 @@ class ArmMeshChecker:
         allowed: Collection[frozenset] = (),
         tolerance: float = 1e-6,
         padding: float = 0.0,
+        link_padding: Mapping[str, float] | None = None,
     ) -> None:
         geometry = arm.geometry
         self.arm, self.tolerance, self.padding = arm, float(tolerance), float(padding)
@@ -185,6 +189,8 @@ class ArmMeshChecker:
         link = [obj.name if obj.name in held else arm.model.frames[obj.parentFrame].name
                 for obj in geometry.geometryObjects]  # fmt: skip
         self._names = link
+        own = dict(link_padding or {})
+        self._paddings = np.array([own.get(name, self.padding) for name in link], dtype=float)
         self._pairs = np.array(
             [
                 (p.first, p.second)
@@ -328,8 +334,8 @@ class ArmMeshChecker:
                     d = self._distance(int(item))
                     queries += 1
                     lowest = min(lowest, d)
-                    if item < len(self._links):  # the scene grown by the padding
-                        d -= self.padding
+                    if item < len(self._links):  # the scene grown by the link's padding
+                        d -= self._paddings[item]
                     if d <= self.tolerance:
                         return ArmPathCheck(True, max(lowest, 0.0), (index, s), queries,
                                             self._what(int(item)),
@@ -376,10 +382,13 @@ def verify_arm_path(
     max_queries: int = 1_000_000,
     allowed: Collection[frozenset] = (),
     padding: float = 0.0,
+    link_padding: Mapping[str, float] | None = None,
 ) -> ArmPathCheck:
     """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints` order)
     without gaps against ``obstacles`` and self-collision (the pairs of
     :attr:`ArmModel.geometry` whose links are not an ``allowed`` pair); see the module
     docstring. To check many paths in one scene, build an :class:`ArmMeshChecker` once.
-    ``padding``: metres every link must keep from the obstacles (:class:`ArmMeshChecker`)."""
-    return ArmMeshChecker(arm, obstacles, allowed, tolerance, padding).check(states, max_queries)
+    ``padding``: metres every link must keep from the obstacles, ``link_padding`` a link's
+    own instead (:class:`ArmMeshChecker`)."""
+    checker = ArmMeshChecker(arm, obstacles, allowed, tolerance, padding, link_padding)
+    return checker.check(states, max_queries)

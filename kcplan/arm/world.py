@@ -22,7 +22,7 @@ function is its vertices' (:class:`kcplan.world.support.PointsSupport`).
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from functools import cached_property
 
 import fcl
@@ -80,6 +80,9 @@ class ArmWorld:
     padding : float, optional
         Metres every body keeps from every obstacle in the compiled :attr:`kernel`'s
         queries (MoveIt's link padding; self pairs are not padded).
+    link_padding : mapping of str to float, optional
+        Metres that the bodies of a link (or of an attached part, by its name) keep
+        instead of ``padding`` (MoveIt's per-link padding).
 
     Notes
     -----
@@ -96,6 +99,7 @@ class ArmWorld:
         allowed: Collection[frozenset] = (),
         prove_pairs: bool = True,
         padding: float = 0.0,
+        link_padding: Mapping[str, float] | None = None,
     ):
         self.arm = arm
         self.obstacles = tuple(obstacles)
@@ -104,6 +108,16 @@ class ArmWorld:
         self.padding = float(padding)
         """Metres every body keeps from every obstacle, kept by :attr:`kernel`'s queries
         (the python-fcl queries of this class do not pad)."""
+        links = {b.link for b in arm.bodies}
+        self.link_padding = dict(link_padding or {})
+        """Metres the bodies of a link (or attached part) keep instead of :attr:`padding`."""
+        for name, value in self.link_padding.items():
+            if name not in links:
+                raise ValueError(f"link_padding: {name!r} is not a link with bodies "
+                                 f"(expected one of {', '.join(sorted(links))})")  # fmt: skip
+            if not (value >= 0.0 and math.isfinite(value)):
+                raise ValueError(f"link_padding.{name}: expected a finite number >= 0, "
+                                 f"got {value!r}")  # fmt: skip
         self.allowed = frozenset(allowed)
         pairs = checked_pairs(arm, self.allowed)
         self.proven_apart = 0

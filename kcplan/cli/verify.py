@@ -100,7 +100,7 @@ def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
     _within_limits(args.path, "states", scenario.arm, states)
     check = verify_arm_path(
         scenario.arm, scenario.obstacles, states, args.tolerance, allowed=scenario.allowed,
-        padding=_padding(args, scenario),
+        padding=_padding(args, scenario), link_padding=scenario.link_padding,
     )  # fmt: skip
     if check.collides:
         edge, s = check.where
@@ -114,7 +114,8 @@ def _verify_arm(args: argparse.Namespace, scenario, states: np.ndarray) -> int:
 
 
 def _padding(args: argparse.Namespace, scenario) -> float:
-    """``--padding``, else the scenario's ``robot.padding``."""
+    """``--padding``, else the scenario's ``robot.padding`` (an arm's links named in its
+    ``robot.link_padding`` keep their own either way)."""
     return scenario.padding if args.padding is None else args.padding
 
 
@@ -122,6 +123,10 @@ def _closer(args: argparse.Namespace, scenario) -> str:
     """How a verdict names a pose nearer than the tolerance: a collision, or nearer than
     the padding when there is one."""
     padding = _padding(args, scenario)
+    own = {k: v for k, v in getattr(scenario, "link_padding", {}).items() if v > 0}
+    if own:
+        links = ", ".join(f"{name} {value:g}" for name, value in sorted(own.items()))
+        return f"CLOSER THAN THE PADDING {padding:g} ({links})"
     return f"CLOSER THAN THE PADDING {padding:g}" if padding > 0 else "COLLISION"
 
 

@@ -370,7 +370,8 @@ class PlanResult:
         """Check the path without gaps, independently of every certificate
         (:func:`kcplan.planning.verify.verify_path`: FCL clearances and conservative
         advancement). ``tolerance`` is in the scenario's length unit; ``padding`` (default:
-        the scenario's) is the clearance the path must keep from the obstacles.
+        the scenario's) is the clearance the path must keep from the obstacles, and an
+        arm's links named in the scenario's ``robot.link_padding`` keep their own.
 
         Raises
         ------
@@ -383,7 +384,8 @@ class PlanResult:
         padding = p.padding if padding is None else float(padding)
         if isinstance(p, ArmScenario):
             return verify_arm_path(p.arm, p.obstacles, self.states, tolerance,
-                                   allowed=p.allowed, padding=padding)  # fmt: skip
+                                   allowed=p.allowed, padding=padding,
+                                   link_padding=p.link_padding)  # fmt: skip
         return verify_path(CollisionWorld(p), self.states, tolerance, padding=padding)
 
     def to_json(self) -> dict:
@@ -467,7 +469,8 @@ def plan(
         The clearance every certified edge keeps from every obstacle and point, in the
         scenario's unit (default: the scenario's ``robot.padding``, else 0): the compiled
         kernel's queries count a body nearer than it as a collision and take it off
-        every clearance (MoveIt's link padding; an arm's self pairs are not padded).
+        every clearance (MoveIt's link padding; an arm's self pairs are not padded). An
+        arm's links named in ``robot.link_padding`` keep their own padding instead.
 
     Returns
     -------

@@ -118,7 +118,8 @@ class ProblemSetup:
 
 def _require_kernel_for_padding(scenario, spec: PlannerSpec) -> None:
     """The padding is kept by the compiled kernel's queries alone (World::set_padding)."""
-    if scenario.padding > 0 and spec.backend != "kernel":
+    padded = scenario.padding > 0 or any(getattr(scenario, "link_padding", {}).values())
+    if padded and spec.backend != "kernel":
         raise ValueError(
             f"padding: kept by the compiled kernel only; {spec.backend} planners ignore it "
             "(use a kernel planner, or no padding)"
@@ -192,8 +193,9 @@ class ArmSetup(ProblemSetup):
         arm = self.robot = self.arm = scenario.arm
         _require_kernel_for_padding(scenario, spec)
         self.world = world or ArmWorld(
-            arm, scenario.obstacles, allowed=scenario.allowed, padding=scenario.padding
-        )
+            arm, scenario.obstacles, allowed=scenario.allowed, padding=scenario.padding,
+            link_padding=scenario.link_padding,
+        )  # fmt: skip
         self.world.reset_counters()
         self.backend, self.joints = spec.backend, arm.joints
         self._open(joint_space(arm.lower, arm.upper))
