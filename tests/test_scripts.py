@@ -493,6 +493,20 @@ CASES.append(
 
 
 CASES.append(
+    Case(  # the cloud tree's two orders: both build, both plan the same problem
+        "cloud_tree_order.py",
+        ("--sizes", "1000", "--repeats", "1", "--per-class", "1", "--classes", "table_pick")
+        + ("--seeds", "1"),
+        (
+            rf"^\| 1,000 \| {NUMBER} / {NUMBER} \| {NUMBER} / {NUMBER} \|$",
+            rf"^\| table_pick 1 \| 120,000 \| morton \| 1 / 1 \| {NUMBER} \| ",
+            rf"^\| table_pick 1 \| 120,000 \| median \| 1 / 1 \| {NUMBER} \| ",
+        ),
+    )
+)
+
+
+CASES.append(
     Case(  # kcplan's half on one small MBM cloud (VAMP's needs its own build): planned on
         # the cloud and on the primitives, every path verified on the meshes
         "cloud_mbm.py",
