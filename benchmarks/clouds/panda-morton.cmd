@@ -1,2 +1,2 @@
-# at 18c4a3b, VAMP 0.6.4 in /work/vamp-venv; shared 2-core machine
+# at c0c5718, VAMP 0.6.4 in /work/vamp-venv; shared 2-core machine, nothing else running
 python scripts/cloud_mbm.py --robot panda --per-class 5 --planner kc-rrtconnect-lazy-native --vamp-python /work/vamp-venv/bin/python --json benchmarks/clouds/panda-morton.json
