@@ -9,7 +9,9 @@ For the first ``--per-class`` problems of each class of a robot's ``problems.tar
    ellipsoid cover, ``--bodies-per-link``, ``--max-offset``); a problem whose start
    or goal the cover touches (valid on the meshes, but not for the covered arm) is
    counted as *invalid for the cover* and not planned: no planner on that cover can
-   solve it;
+   solve it; with ``--padding P`` (metres) every scenario keeps ``robot.padding: P``
+   (MoveIt's link padding: every certified path at least ``P`` from every obstacle), and a
+   start or goal nearer than ``P`` to an obstacle is counted there too;
 2. ``kcplan bench`` runs every ``--planners`` on the others, one run each (seed
    ``--seed``), ``--time`` seconds, no simplification (``--simplify``: with it, and its
    median milliseconds and the median path length in the table), into ``DIR/bench`` (its OMPL
@@ -28,8 +30,8 @@ planning time in milliseconds::
 
     python scripts/mbm_bench.py [--robot panda|ur5] [--per-class 20] [--classes box,cage]
         [--planners kc-rrtconnect,rrtconnect,...] [--time 10] [--representation R]
-        [--bodies-per-link K] [--max-offset D] [--jobs J] [--simplify] [--vamp-python PY]
-        [-o DIR]
+        [--bodies-per-link K] [--max-offset D] [--jobs J] [--simplify] [--padding P]
+        [--vamp-python PY] [-o DIR]
 
 A shared, loaded machine makes the times indicative; the counts are what they are.
 """
@@ -39,6 +41,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -88,9 +91,14 @@ def write_scenarios(args: argparse.Namespace, folder: Path) -> dict[str, list]:
             key = yaml.safe_dump(data["robot"], sort_keys=True)
             if key not in arms:  # one cover per robot description (fixed joints included)
                 arms[key] = parse_scenario(data, os.fspath(path), folder, check=False).arm
-            world = ArmWorld(arms[key], problem.obstacles, allowed=problem.allowed)
+            if args.padding > 0:
+                data["robot"]["padding"] = args.padding
+            world = ArmWorld(arms[key], problem.obstacles, allowed=problem.allowed,
+                             padding=args.padding)  # fmt: skip
+            # the kernel's query pads; python-fcl's (ArmWorld.in_collision) does not
             touched = [k for k, q in (("start", problem.start), ("goal", problem.goal))
-                       if world.in_collision(q)]  # fmt: skip
+                       if (world.kernel.in_collision(q.tolist()) if args.padding > 0
+                           else world.in_collision(q))]  # fmt: skip
             if touched:
                 invalid.append((index, "both" if len(touched) == 2 else touched[0]))
                 continue
@@ -131,7 +139,8 @@ def run_vamp(args: argparse.Namespace, folder: Path) -> dict:
 def table(args: argparse.Namespace, scenarios: dict, rows: list[dict], vamp: dict) -> list[str]:
     """The Markdown table (module docstring)."""
     planners = args.planners.split(",")
-    head = ["class", "problems", "invalid for the cover"]
+    padded = f" or nearer than {args.padding:g} m" if args.padding > 0 else ""
+    head = ["class", "problems", f"invalid for the cover{padded}"]
     for planner in planners:
         head += [f"{planner} solved", "median ms", "colliding"]
         if args.simplify:
@@ -193,6 +202,8 @@ def main(argv: list[str] | None = None) -> int:
                         "at most K)")  # fmt: skip
     parser.add_argument("--max-offset", type=float, default=None,
                         help="the cover: metres it may stick out of each link's mesh")  # fmt: skip
+    parser.add_argument("--padding", type=float, default=0.0,
+                        help="metres every path keeps from the obstacles (robot.padding)")
     parser.add_argument("--vamp-python", help="a Python with VAMP: also run VAMP")
     parser.add_argument("-o", "--output", default="mbm-bench", help="output folder")
     args = parser.parse_args(argv)
@@ -201,6 +212,8 @@ def main(argv: list[str] | None = None) -> int:
     if unknown or args.per_class < 1 or args.time <= 0:
         parser.error(f"--classes: expected some of {', '.join(MBM_CLASSES)}; --per-class "
                      f"and --time: positive (got {unknown or ''})")  # fmt: skip
+    if not (args.padding >= 0 and math.isfinite(args.padding)):
+        parser.error(f"--padding: expected a finite number >= 0 (metres), got {args.padding}")
     folder = Path(args.output).resolve()  # the bench runs from the repository's root
     scenarios = write_scenarios(args, folder / "scenarios")
     files = [path for written, _ in scenarios.values() for path in written]

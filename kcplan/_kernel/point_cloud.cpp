@@ -44,6 +44,36 @@ std::uint64_t spread_bits(std::uint32_t v) {
   return x;
 }
 
+/// The n points `xyz` (n x 3) sorted along a Morton curve: per point a key, its 30-bit
+/// code in bits 32-61 (cubic cells, 1024 to the longest side of the box lo-hi that holds
+/// them) and its index below, the keys in the code's order (ties in the index's).
+std::vector<std::uint64_t> morton_keys(const double* xyz, std::size_t n, const Vec3s& lo,
+                                       const Vec3s& hi) {
+  const double side = (hi - lo).maxCoeff();
+  const double scale = side > 0.0 ? 1023.0 / side : 0.0;
+  auto cell = [scale](double v) {
+    return static_cast<std::uint32_t>(std::clamp(v * scale, 0.0, 1023.0));
+  };
+  std::vector<std::uint64_t> keys(n), sorted(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = xyz + 3 * i;
+    const std::uint64_t code = spread_bits(cell(p[0] - lo[0])) |
+                               spread_bits(cell(p[1] - lo[1])) << 1 |
+                               spread_bits(cell(p[2] - lo[2])) << 2;
+    keys[i] = code << 32 | i;
+  }
+  // least significant digit first, 10 bits a pass: 3 passes, each stable
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::array<std::uint32_t, 1025> start{};
+    for (const std::uint64_t k : keys) ++start[((k >> shift) & 1023u) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    for (const std::uint64_t k : keys) sorted[start[(k >> shift) & 1023u]++] = k;
+    keys.swap(sorted);
+  }
+  return keys;
+}
+
+
 }  // namespace
 
 const PointCloud::Dop& PointCloud::dop_of(const coal::CollisionGeometry& hull,
@@ -157,22 +187,26 @@ PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, CloudOrd
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw std::invalid_argument("point cloud: expected a finite radius > 0");
   if (leaf_size == 0) leaf_size = 1;
-  points_.reserve(n);
+  Vec3s lo = Vec3s::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (std::size_t i = 0; i < n; ++i) {
-    const double* p = xyz + 3 * i;
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw std::invalid_argument("point cloud: expected finite coordinates");
-    points_.emplace_back(p[0], p[1], p[2]);
+    const Eigen::Map<const Vec3s> p(xyz + 3 * i);
+    if (!p.allFinite()) throw std::invalid_argument("point cloud: expected finite coordinates");
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
   }
   // a split leaves at least one point on each side: at most 2 n - 1 nodes
   nodes_.reserve(order == CloudOrder::median ? 4 * (n / leaf_size + 1) : 2 * n);
   nodes_.resize(1);
+  points_.resize(n);
   if (order == CloudOrder::median) {
+    for (std::size_t i = 0; i < n; ++i) points_[i] = Eigen::Map<const Vec3s>(xyz + 3 * i);
     build_median(0, 0, static_cast<std::uint32_t>(n), leaf_size);
-  } else {
-    const std::vector<std::uint32_t> codes = sort_morton();
-    Vec3s lo, hi;
-    build_cells(0, 0, static_cast<std::uint32_t>(n), codes, leaf_size, lo, hi);
+  } else {  // the points copied once, in the curve's order
+    const std::vector<std::uint64_t> keys = morton_keys(xyz, n, lo, hi);
+    for (std::size_t i = 0; i < n; ++i)
+      points_[i] = Eigen::Map<const Vec3s>(xyz + 3 * (keys[i] & 0xffffffffu));
+    Vec3s node_lo, node_hi;
+    build_cells(0, 0, static_cast<std::uint32_t>(n), keys, leaf_size, node_lo, node_hi);
   }
   const Node& root = nodes_[0];
   const Vec3s grow = root.half + Vec3s::Constant(radius_);
@@ -202,47 +236,8 @@ void PointCloud::build_median(std::size_t index, std::uint32_t begin, std::uint3
   build_median(left + 1, middle, end, leaf_size);
 }
 
-std::vector<std::uint32_t> PointCloud::sort_morton() {
-  const std::size_t n = points_.size();
-  Vec3s lo = points_[0], hi = points_[0];
-  for (const Vec3s& p : points_) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  // cubic cells (one scale on every axis), 1024 to the box's longest side
-  const double side = (hi - lo).maxCoeff();
-  const double scale = side > 0.0 ? 1023.0 / side : 0.0;
-  auto cell = [scale](double v) {
-    return static_cast<std::uint32_t>(std::clamp(v * scale, 0.0, 1023.0));
-  };
-  // a key: the code in bits 32-61, the point's index below it
-  std::vector<std::uint64_t> keys(n), sorted(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3s d = points_[i] - lo;
-    const std::uint64_t code =
-        spread_bits(cell(d[0])) | spread_bits(cell(d[1])) << 1 | spread_bits(cell(d[2])) << 2;
-    keys[i] = code << 32 | i;
-  }
-  // least significant digit first, 10 bits a pass: 3 passes, each stable
-  for (int shift = 32; shift < 62; shift += 10) {
-    std::array<std::uint32_t, 1025> start{};
-    for (const std::uint64_t k : keys) ++start[((k >> shift) & 1023u) + 1];
-    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-    for (const std::uint64_t k : keys) sorted[start[(k >> shift) & 1023u]++] = k;
-    keys.swap(sorted);
-  }
-  std::vector<Vec3s> ordered(n);
-  std::vector<std::uint32_t> codes(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    ordered[i] = points_[keys[i] & 0xffffffffu];
-    codes[i] = static_cast<std::uint32_t>(keys[i] >> 32);
-  }
-  points_.swap(ordered);
-  return codes;
-}
-
 void PointCloud::build_cells(std::size_t index, std::uint32_t begin, std::uint32_t end,
-                             const std::vector<std::uint32_t>& codes, std::size_t leaf_size,
+                             const std::vector<std::uint64_t>& keys, std::size_t leaf_size,
                              Vec3s& lo, Vec3s& hi) {
   std::int32_t left = -1;
   if (end - begin <= leaf_size) {
@@ -255,20 +250,21 @@ void PointCloud::build_cells(std::size_t index, std::uint32_t begin, std::uint32
     // split where the highest bit in which the range's codes differ turns to 1 (the
     // codes are sorted: every code before has it 0); one cell: at the middle
     std::uint32_t middle = begin + (end - begin) / 2;
-    const std::uint32_t differ = codes[begin] ^ codes[end - 1];
+    const std::uint64_t differ = (keys[begin] ^ keys[end - 1]) >> 32;
     if (differ != 0) {
-      std::uint32_t bit = 1u << 31;
+      std::uint64_t bit = std::uint64_t{1} << 31;
       while ((differ & bit) == 0) bit >>= 1;
+      bit <<= 32;  // the code's bit, in the key
       middle = static_cast<std::uint32_t>(
-          std::partition_point(codes.begin() + begin, codes.begin() + end,
-                               [bit](std::uint32_t c) { return (c & bit) == 0; }) -
-          codes.begin());
+          std::partition_point(keys.begin() + begin, keys.begin() + end,
+                               [bit](std::uint64_t k) { return (k & bit) == 0; }) -
+          keys.begin());
     }
     left = static_cast<std::int32_t>(nodes_.size());
     nodes_.resize(nodes_.size() + 2);
     Vec3s right_lo, right_hi;
-    build_cells(left, begin, middle, codes, leaf_size, lo, hi);
-    build_cells(left + 1, middle, end, codes, leaf_size, right_lo, right_hi);
+    build_cells(left, begin, middle, keys, leaf_size, lo, hi);
+    build_cells(left + 1, middle, end, keys, leaf_size, right_lo, right_hi);
     lo = lo.cwiseMin(right_lo);
     hi = hi.cwiseMax(right_hi);
   }

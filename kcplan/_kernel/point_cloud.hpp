@@ -136,13 +136,12 @@ class PointCloud {
   /// points split at the median of the box's longest side (CloudOrder::median).
   void build_median(std::size_t index, std::uint32_t begin, std::uint32_t end,
                     std::size_t leaf_size);
-  /// Sort points_ along the Morton curve (CloudOrder::morton); their sorted codes.
-  std::vector<std::uint32_t> sort_morton();
   /// Fill node `index` (already allocated) with points_[begin, end) and its subtree, the
-  /// range split between the two halves of its Morton cell; the box from the children's;
-  /// `lo`, `hi` get its corners.
+  /// range split between the two halves of its Morton cell (`keys`: the points' sorted
+  /// Morton keys, the code in bits 32-61); the box from the children's; `lo`, `hi` get
+  /// its corners.
   void build_cells(std::size_t index, std::uint32_t begin, std::uint32_t end,
-                   const std::vector<std::uint32_t>& codes, std::size_t leaf_size,
+                   const std::vector<std::uint64_t>& keys, std::size_t leaf_size,
                    coal::Vec3s& lo, coal::Vec3s& hi);
   /// GJK's distance from the query shape to the ball about point i (<= 0: contact).
   /// `towards` gets GJK's unit direction from the ball to the shape (zero if none).
