@@ -1,6 +1,10 @@
-"""Arm robots: a URDF's chain (read by Pinocchio) with its links covered by ellipsoids.
+"""Arm robots: a URDF's chain (read by Pinocchio), each link its own convex hull.
 
-:func:`load_arm` builds an :class:`ArmModel` (the immutable description);
+:func:`load_arm` builds an :class:`ArmModel` (the immutable description): by default
+each link is its collision mesh's convex hull (:mod:`kcplan.arm.hulls`), or, asked for,
+covered by ellipsoids (:mod:`kcplan.cover`); parts can be attached to a link
+(:mod:`kcplan.arm.attach`) and pairs of links proven never to touch are left out
+(:mod:`kcplan.arm.pairs`);
 :mod:`kcplan.arm.kinematics` computes joint and body frames from it, and
 :mod:`kcplan.arm.bounds` bounds how far its bodies move along a joint-space edge.
 """

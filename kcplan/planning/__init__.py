@@ -1,10 +1,13 @@
-"""Planning with OMPL: the motion validator, edge certificates, planners, verification.
+"""Where a path is made: OMPL's planners with the KC motion validator, and the compiled loop.
 
-:mod:`.guard`, :mod:`.certificates`, :mod:`.certifier`, :mod:`.ladder` and :mod:`.verify`
-do not import OMPL; :mod:`.validator`, :mod:`.states`, :mod:`.setups` (what each robot
-kind puts into OMPL) and :mod:`.problem` (:func:`~.problem.plan`, the same for every
-kind) are the thin OMPL adapters. :mod:`.native` runs an arm's planning loop in the
-compiled kernel instead (``kc-rrtconnect-native``), with no OMPL or Python per edge.
+:mod:`.validator`, :mod:`.states`, :mod:`.setups` (what each robot kind puts into OMPL)
+and :mod:`.problem` (:func:`~.problem.plan`, the same for every kind) are the thin OMPL
+adapters; :mod:`.lazy` screens a tree's edges and certifies only the path it returns;
+:mod:`.native` runs an arm's planning loop in the compiled kernel instead
+(``kc-rrtconnect-native``), with no OMPL or Python per edge; :mod:`.names` lists the
+planners without loading OMPL; :mod:`.verify` checks a path gap-free, independent of the
+certificates. Where an edge is decided is :mod:`kcplan.certification`; what is done to a
+path once found (blends, timing) is :mod:`kcplan.trajectory`.
 """
 
 from kcplan.certification import (
