@@ -73,7 +73,6 @@ std::vector<std::uint64_t> morton_keys(const double* xyz, std::size_t n, const V
   return keys;
 }
 
-
 }  // namespace
 
 const PointCloud::Dop& PointCloud::dop_of(const coal::CollisionGeometry& hull,
