@@ -72,19 +72,15 @@ def test_a_link_nearer_than_its_padding_collides(box):
 
 
 def test_a_planned_path_keeps_each_links_padding_on_the_meshes(box):
-    # the wrist's link 5 keeps 4 cm; the hand, which the goal puts within millimetres of
-    # the box, keeps nothing
-    own = {"panda_link5": 0.04}
-    padded = dataclasses.replace(box, link_padding=own)
-    bare = plan(box, time_limit=20, seed=1)
-    # the premise: planned without it, link 5 passes nearer than 4 cm (the verifier sees
-    # a link's own padding)
-    assert dataclasses.replace(bare, problem=padded).verify().collides
+    # the wrist's link 5 keeps 4 cm (an unpadded path may pass nearer: one did);
+    # the hand, which the goal puts within millimetres of the box, keeps nothing
+    padded = dataclasses.replace(box, link_padding={"panda_link5": 0.04})
     result = plan(padded, time_limit=20, seed=1)
     assert result.solved
     check = result.verify()  # PlanResult.verify reads the scenario's link_padding
     assert not check.collides, check
-    # and the same path is too near for 30 cm
+    assert check.min_clearance < 0.04  # the other links came nearer: link 5 alone kept it
+    # the verifier sees a link's own padding: the same path is too near for 30 cm
     too_much = dataclasses.replace(padded, link_padding={"panda_link5": 0.3})
     assert dataclasses.replace(result, problem=too_much).verify().collides
 
