@@ -39,6 +39,20 @@ greedy tree's outcome is partly luck, and on some CAD meshes theirs is the bette
 Every tree is a tree of planes whose leaves are fitted to their full hull points, so each
 is sound.
 
+*Reflex pieces* (:data:`PIECES`, with ``bodies``). A part whose reflex (concave) edges
+all lie on a few planes of its faces (:func:`_reflex_planes`: an extruded I, H, T, L, Z
+or C section, a U-channel, any union of slabs) is cut along those planes, moved a hair
+off their faces, into the pieces with no reflex edge inside, at most ``bodies`` of them,
+whose ellipsoids' total volume is the smallest (an exact search over those planes,
+:meth:`_Search.pieces`): for a union of ``k <= bodies`` slabs, at most its slabs' own
+smallest ellipsoids. That total is then a *ceiling*: that tree is grown by the greedy
+cuts that keep its total under it (:meth:`_Search.best_cut_within`), and the cover kept
+is the smallest union of the trees whose total is under it. The greedy trees alone got
+an I-beam of three slabs 6.0 times its volume from 3 bodies (its slabs 2.72: the first
+greedy cut is the best one for two bodies, and a cut in the plane of a flange's inner
+face leaves that face in the web's piece) and 4.9 from 4 (issue 58). A part with no such
+planes (a curved hollow, a ring) is fitted as without them.
+
 *By how far the cover sticks out* (``max_offset``, 3D). Volume does not see a body that
 bulges a centimetre out of a flat face, and a grasp that leaves a finger 9 mm from an
 object then collides for the cover (issue 25). With ``max_offset``, the tree is grown
@@ -66,6 +80,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import trimesh
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 from scipy.stats import qmc
@@ -95,10 +110,12 @@ __all__ = [
     "fit_cover",
 ]
 
-FIT_VERSION = 4
+FIT_VERSION = 5
 """Changes whenever the fit by volume (``bodies`` or ``max_excess``) would give other
 bodies for the same input (cache key). 3: cuts at quantiles of the curvature measure,
-not of the mesh's vertices. 4: the vertices' trees as well (:data:`VERTEX_CUTS`)."""
+not of the mesh's vertices. 4: the vertices' trees as well (:data:`VERTEX_CUTS`). 5: the
+reflex pieces' tree and its ceiling (:data:`PIECES`; parts without reflex planes, such
+as the Panda's links, are fitted as at 4)."""
 OFFSET_FIT_VERSION = 2
 """The same for a ``max_offset`` fit, whose candidate cuts are its own
 (:data:`OFFSET_FRACTIONS`)."""
@@ -132,6 +149,34 @@ make a cover smaller than the curvature's trees make it alone (on the score's sa
 the sector tree is chosen by the curvature's trees alone, as without them. On the UR5's
 upper arm they give 1.456 times the part at four bodies against the curvature's 1.511
 (``benchmarks/RESULTS.md`` 24.1), in 1.7 times the time of the curvature's trees alone."""
+PIECES = True
+"""Also cut the part along the planes of its reflex edges (:func:`_reflex_planes`) into
+the pieces whose ellipsoids' total volume is smallest (:meth:`_Search.pieces`), keep no
+cover whose total exceeds theirs, and grow their tree within it (see the module
+docstring; issue 58: a profile made of slabs is then covered by no more than its slabs'
+own ellipsoids, whatever its triangulation)."""
+CEILING_TRIES = 64
+"""At most this many cuts, the smallest unions first, are fitted in
+:meth:`_Search.best_cut_within` to find one that keeps the total under the ceiling."""
+REFLEX_ANGLE = math.radians(10.0)
+"""A reflex edge (corner) whose faces turn by less than this does not count: a nearly
+flat crease (the Panda's finger has one of 0.55 degrees, on which the reflex pieces'
+ceiling would cost its cover 15 % of union at two bodies), or a facet of a curved hollow
+of more than 36 facets a turn."""
+REFLEX_PLANES = 8
+"""A part whose reflex edges need more planes than this gets no reflex pieces."""
+PLANE_SHIFT = 1e-9
+"""How far a reflex plane's cut is moved off its faces, over the part's size, beyond the
+faces' own spread about the plane (:func:`_reflex_planes`)."""
+PIECES_BODIES = 6
+"""The exact search of :meth:`_Search.pieces` takes at most this many pieces (it is
+exponential in them); the greedy cuts go on from there."""
+PIECES_FITS = 400
+"""... and fits at most this many distinct pieces, beyond which a piece is not cut."""
+PIECES_GAIN = 1e-3
+"""More pieces are taken only when their total is smaller by more than this share: a
+slab cut in two has the same total (up to Khachiyan's tolerance), and the greedy cuts
+that follow make the union smaller with the bodies it leaves."""
 LOOKAHEAD = 3
 """When no single cut shrinks the union, this many best cuts of each leaf are tried as
 the first of two."""
@@ -298,13 +343,40 @@ def _face_planes(boundary: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     areas : ndarray, shape (m,)
         Area (length in 2D) of the boundary on each plane.
     """
+    _, normals, offsets, total, surface = _plane_groups(boundary)
+    order = np.argsort(-total)
+    order = order[total[order] >= FACE_SHARE * surface]
+    return normals[order], offsets[order], total[order]
+
+
+def _plane_groups(
+    boundary: NDArray, oriented: bool = False
+) -> tuple[NDArray, NDArray, NDArray, NDArray, float]:
+    """The boundary simplices grouped by the plane they lie in (unit normals and offsets
+    over the part's size agreeing to :data:`PLANE_TOL`; with ``oriented``, by their
+    outward normals, so that faces on the two sides of one plane are two groups).
+
+    Returns
+    -------
+    group : ndarray of int, shape (k,)
+        Each simplex's plane, -1 for a simplex without area.
+    normals : ndarray, shape (g, n)
+        The planes' unit normals, signed so that the largest component is positive
+        (outward with ``oriented``).
+    offsets : ndarray, shape (g,)
+    areas : ndarray, shape (g,)
+        Area (length in 2D) of the boundary on each plane.
+    surface : float
+        The whole boundary's area (length).
+    """
     n = boundary.shape[-1]
     normal, area = simplex_normals(boundary)
     length = np.linalg.norm(normal, axis=1)
     keep = length > 0
     normal = normal[keep] / length[keep, None]
-    sign = np.sign(normal[np.arange(len(normal)), np.abs(normal).argmax(axis=1)])
-    normal *= sign[:, None]
+    if not oriented:
+        sign = np.sign(normal[np.arange(len(normal)), np.abs(normal).argmax(axis=1)])
+        normal *= sign[:, None]
     offset = np.einsum("ij,ij->i", normal, boundary[keep, 0])
     size = float(np.ptp(boundary.reshape(-1, n), axis=0).max())
     key = np.round(np.column_stack([normal / PLANE_TOL, offset / (PLANE_TOL * size)]))
@@ -315,9 +387,88 @@ def _face_planes(boundary: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     normals = np.stack([np.bincount(group, weight * normal[:, j]) for j in range(n)], axis=1)
     offsets = np.bincount(group, weight * offset) / total
     normals /= np.linalg.norm(normals, axis=1)[:, None]
-    order = np.argsort(-total)
-    order = order[total[order] >= FACE_SHARE * area.sum()]
-    return normals[order], offsets[order], total[order]
+    every = np.full(len(boundary), -1)
+    every[keep] = group
+    return every, normals, offsets, total, float(area.sum())
+
+
+def _reflex_planes(solid: Solid) -> tuple[NDArray, NDArray, NDArray, float]:
+    """Cuts along the planes of the part's faces that meet another face at a *reflex*
+    (concave) edge (a 2D outline's edges at its reflex corners), if at most
+    :data:`REFLEX_PLANES` planes, each carrying :data:`FACE_SHARE` of the part's surface,
+    hold every reflex edge whose faces turn by :data:`REFLEX_ANGLE` or more; else none.
+
+    Cutting a polyhedron along the planes through all its reflex edges leaves convex
+    pieces: the inner faces of an I-beam's flanges cut it into its flanges and its web,
+    and so for any extruded union of slabs. A part with a curved hollow (many small
+    facets meeting at small reflex angles) has no such planes, and gets none.
+
+    Each plane is moved off its faces, outwards (along their outward normal) by how far
+    their corners lie from it plus :data:`PLANE_SHIFT` of the part's size, so that the
+    faces fall on their own solid's side only: a triangle in a cutting plane stays on
+    both sides (:func:`kcplan.cover.partition.clip_simplices`, which soundness needs), and
+    the flange's inner face would make the web's piece as wide as the flange. The
+    flange's piece then holds a sliver of the web as thin as that shift, and with it the
+    reflex edges, that close to the cut.
+
+    Returns
+    -------
+    normals : ndarray, shape (m, n)
+        Unit normals, outward of the faces; the planes with the most reflex edge first
+        (its length times its angle; the corners' angles in 2D).
+    offsets : ndarray, shape (m,)
+    edges : ndarray, shape (e, 2, n)
+        The reflex edges (a 2D outline's reflex corners, as segments of length zero).
+    margin : float
+        Twice the largest shift: a reflex edge nearer than this to a cut lies in a sliver.
+    """
+    boundary = solid.boundary
+    group, normals, offsets, total, surface = _plane_groups(boundary, oriented=True)
+    if solid.dimension == 3:
+        mesh = trimesh.Trimesh(solid.vertices, solid.faces, process=False)
+        pairs = np.asarray(mesh.face_adjacency)  # (a, 2): faces that share an edge
+        angle = np.asarray(mesh.face_adjacency_angles, dtype=float)
+        edges = np.asarray(mesh.vertices)[mesh.face_adjacency_edges]
+        weight = angle * np.linalg.norm(edges[:, 1] - edges[:, 0], axis=1)
+        reflex = ~np.asarray(mesh.face_adjacency_convex, dtype=bool) & (angle >= REFLEX_ANGLE)
+    else:  # corner i joins edges i - 1 and i of the counter-clockwise outline
+        d = boundary[:, 1] - boundary[:, 0]
+        before = np.roll(d, 1, axis=0)
+        turn = np.arctan2(before[:, 0] * d[:, 1] - before[:, 1] * d[:, 0], (before * d).sum(1))
+        pairs = np.column_stack([np.roll(np.arange(len(d)), 1), np.arange(len(d))])
+        edges = np.stack([boundary[:, 0], boundary[:, 0]], axis=1)
+        weight, reflex = -turn, turn <= -REFLEX_ANGLE  # a clockwise turn
+    carried = np.zeros(len(normals))
+    for side in (0, 1):
+        g = group[pairs[reflex, side]]
+        np.add.at(carried, g[g >= 0], weight[reflex][g >= 0])
+    keep = np.flatnonzero((carried > 0) & (total >= FACE_SHARE * surface))
+    keep = keep[np.argsort(-carried[keep], kind="stable")]
+    held = np.isin(group[pairs[reflex]], keep).any(axis=1)  # a face on a kept plane
+    if len(keep) > REFLEX_PLANES or not held.all():
+        keep = keep[:0]  # not a union of convex pieces that these planes cut apart
+    on = group >= 0
+    apart = np.einsum("kcn,kn->kc", boundary[on], normals[group[on]])
+    apart = np.abs(apart - offsets[group[on]][:, None]).max(axis=1)
+    residual = np.zeros(len(normals))
+    np.maximum.at(residual, group[on], apart)
+    shift = residual[keep] + PLANE_SHIFT * solid.size
+    margin = 2.0 * float(shift.max()) if len(keep) else 0.0
+    return normals[keep], offsets[keep] + shift, edges[reflex], margin
+
+
+def _holds_edges(piece: Piece, edges: NDArray, margin: float) -> bool:
+    """Whether a stretch of the segments ``edges`` ``(e, 2, n)`` (points, when of length
+    zero) lies in the piece's cell farther than ``margin`` from its sides."""
+    if len(edges) == 0:
+        return False
+    try:
+        cell = ConvexHull(piece.corners).equations.copy()
+    except (QhullError, ValueError):  # a flat cell holds no stretch of an edge
+        return False
+    cell[:, -1] += margin  # unit normals: the cell shrunk by margin
+    _, measures = clip_segments(edges, np.ones(len(edges)), cell)
+    return bool((measures > 0.0).any())
 
 
 def _pencil_normal(R: NDArray, axis: int, angle: float) -> NDArray:
@@ -422,6 +573,10 @@ class _Search:
         self.features = features
         """The part's curvature measure (:func:`feature_segments`), on first use (the fit
         by offset takes none); the searches of one fit share it."""
+        self.reflex: tuple[NDArray, NDArray, NDArray, float] | None = None
+        """The part's reflex planes (:func:`_reflex_planes`), on first use."""
+        self.piece_trees: dict[bytes, list[tuple[float, tuple | None]]] = {}
+        """The best trees of the pieces :meth:`pieces` met, by their hull's corners."""
 
     def leaf(self, piece: Piece, points: NDArray | None = None) -> _Leaf:
         """A leaf of the piece, its ellipsoid fitted to its full hull points (``points``,
@@ -472,6 +627,98 @@ class _Search:
             return root, split(root, self.root.piece, -np.pi, np.pi, m)
         except _EmptySector:
             return None
+
+    def pieces(self, most: int) -> tuple[dict, list[_Leaf]] | None:
+        """The part cut along its reflex planes (:func:`_reflex_planes`) into pieces with
+        no reflex edge inside (but within the planes' shift of a cut: each piece's
+        connected parts are convex), at most ``most`` and :data:`PIECES_BODIES` of them,
+        whose ellipsoids' total volume is the smallest of any such tree (of the fewest
+        pieces within :data:`PIECES_GAIN` of it): a fresh tree and its leaves, or None
+        when there is no such tree (no reflex planes, or more pieces needed).
+
+        The search is exact over these planes (dynamic programming: a piece's best tree of
+        at most ``m`` leaves is itself, if it holds no reflex edge, or a plane that
+        crosses it and the best trees of ``m1`` and ``m - m1`` leaves of its two sides),
+        its pieces keyed by their hull's corners, so that a piece reached by cuts in
+        another order is fitted once (:attr:`piece_trees`); at most :data:`PIECES_FITS`
+        pieces are fitted, and a piece met after that is not cut. The leaves of the tree
+        kept are fitted again on their own path's pieces, the points :func:`check_cover`
+        derives.
+
+        Parameters
+        ----------
+        most : int
+            The most leaves.
+
+        Returns
+        -------
+        root : dict
+            The tree's root node (leaves' nodes are the leaves' own, as :meth:`sectors`).
+        leaves : list of _Leaf
+            Their ellipsoids fitted at :data:`FINAL_TOL`.
+        """
+        if self.reflex is None:
+            self.reflex = _reflex_planes(self.solid)
+        normals, offsets, edges, margin = self.reflex
+        most = min(most, PIECES_BODIES)
+        if len(normals) == 0 or most < 2:
+            return None
+        boundary, size = self.solid.boundary, self.solid.size
+        memo = self.piece_trees
+
+        def best(piece: Piece, budget: int) -> list[tuple[float, tuple | None]]:
+            """``(total volume, plan)`` of the best tree of at most ``m`` leaves, for ``m``
+            from 1 to ``budget`` (an infinite total: none); a plan is None (the piece as
+            one leaf) or ``(plane, m1, m2)``."""
+            points, _ = _hull_vertices(piece.points(boundary), self.unique)
+            key = np.round(points / (PLANE_TOL * size)).astype(np.int64)
+            key = key[np.lexsort(key.T[::-1])].tobytes()
+            known = memo.get(key)
+            if known is not None and (len(known) >= budget or len(memo) >= PIECES_FITS):
+                return (known + known[-1:] * budget)[:budget]  # at most m leaves: m + 1 too
+            cross = np.flatnonzero(_crossing(piece.boundary_points, normals, offsets))
+            volume = math.inf  # a piece that holds a reflex edge is cut
+            if not _holds_edges(piece, edges, margin):
+                volume = ellipsoid_volume(_enclosing(points, self.shape, FINAL_TOL)[1])
+            out: list[tuple[float, tuple | None]] = [(volume, None)] * budget
+            memo[key] = out[:1]  # while its cuts are searched (a cut makes it smaller)
+            if budget > 1 and len(memo) < PIECES_FITS:
+                for i in cross:
+                    below = piece.cut(normals[i], offsets[i])
+                    above = piece.cut(-normals[i], -offsets[i])
+                    low, high = best(below, budget - 1), best(above, budget - 1)
+                    for m in range(2, budget + 1):
+                        for m1 in range(1, m):
+                            total = low[m1 - 1][0] + high[m - m1 - 1][0]
+                            if total < out[m - 1][0]:
+                                out[m - 1] = (total, (int(i), m1, m - m1))
+                for m in range(1, budget):  # fewer leaves when no worse (but for rounding)
+                    if out[m - 1][0] <= out[m][0] * (1.0 + 1e-9):
+                        out[m] = out[m - 1]
+            memo[key] = out
+            return out
+
+        def build(node: dict, piece: Piece, m: int) -> list[_Leaf]:
+            plan = best(piece, m)[m - 1][1]
+            if plan is None:
+                leaf = self.leaf(piece)
+                leaf.node = node
+                return [leaf]
+            i, m1, m2 = plan
+            normal, offset = normals[i], float(offsets[i])
+            node |= {"plane": [*normal.tolist(), offset], "below": {}, "above": {}}
+            below = build(node["below"], piece.cut(normal, offset), m1)
+            return below + build(node["above"], piece.cut(-normal, -offset), m2)
+
+        whole = self.root.piece
+        totals = [total for total, _ in best(whole, most)]
+        if not math.isfinite(totals[-1]):
+            return None
+        fewest = next(
+            m for m in range(1, most + 1) if totals[m - 1] <= totals[-1] * (1 + PIECES_GAIN)
+        )
+        root: dict = {}
+        return root, build(root, whole, fewest)
 
     def planes(self, leaf: _Leaf) -> list[tuple[NDArray, float]]:
         """Candidate cuts of a leaf as ``(normal, offset)``: across its ellipsoid's and the
@@ -581,6 +828,29 @@ class _Search:
                     best = (union, k, normal, offset, children)
         return best
 
+    def best_cut_within(
+        self, leaves: list[_Leaf], union: float, most: float
+    ) -> tuple[float, int, NDArray, float, tuple] | None:
+        """The cut of any leaf that leaves the smallest union below ``union`` among those
+        that leave the bodies' total volume at most ``most`` (each fitted as if chosen, in
+        order of union, at most :data:`CEILING_TRIES` of them): ``(union volume, leaf
+        index, normal, offset, children)``, or None."""
+        total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
+        cuts = [
+            (cut[0], k, j, cut[1], cut[2])
+            for k in range(len(leaves))
+            for j, cut in enumerate(self.ranked_cuts(leaves, k))
+        ]
+        cuts.sort(key=lambda cut: cut[:3])
+        for estimate, k, _, normal, offset in cuts[:CEILING_TRIES]:
+            if not estimate < union:
+                break
+            children = self.children(leaves[k], normal, offset)
+            after = total - ellipsoid_volume(leaves[k].M)
+            if after + sum(ellipsoid_volume(child.M) for child in children) <= most:
+                return estimate, k, normal, offset, children
+        return None
+
 
 def fit_cover(
     solid: Solid,
@@ -663,8 +933,19 @@ def fit_cover(
         sectors = _best_sectors(search, bodies, [growths[k] for k in own])
         if sectors is not None:
             growths.append(_grow(search, *sectors, bodies, None, reporter("sectors")))
+    ceiling = math.inf
+    if bodies is not None and PIECES:
+        pieces = searches[0].pieces(bodies)
+        if pieces is not None:
+            # with a little room for rounding: the other trees' pieces fit as well
+            ceiling = sum(ellipsoid_volume(leaf.M) for leaf in pieces[1]) * (1.0 + 1e-9)
+            report = reporter("reflex pieces")
+            growths.append(_grow(searches[0], *pieces, bodies, None, report, ceiling))
     if max_excess is None:
-        growth = min(growths, key=lambda g: g.union)
+        # the smallest union of the trees whose bodies' total (the bound that
+        # Cover.volume_bound reports) is at most the reflex pieces' own: the pieces' tree
+        # is one of them, so a part made of a few slabs is never looser than they are
+        growth = min((g for g in growths if g.total <= ceiling), key=lambda g: g.union)
     else:  # the fewest bodies within the bound, then the smallest union
         growth = min(growths, key=lambda g: (len(g.leaves), g.union))
         total = sum(ellipsoid_volume(leaf.M) for leaf in growth.leaves)
@@ -694,6 +975,11 @@ class _Growth:
     def union(self) -> float:
         return self.trail[len(self.leaves)]
 
+    @property
+    def total(self) -> float:
+        """The leaves' ellipsoids' total volume."""
+        return sum(ellipsoid_volume(leaf.M) for leaf in self.leaves)
+
 
 def _grow(
     search: _Search,
@@ -702,10 +988,13 @@ def _grow(
     target: int,
     max_excess: float | None,
     report: Callable[[int], None],
+    ceiling: float = math.inf,
 ) -> _Growth:
     """Cut the leaves of the tree ``root``, one cut at a time, until there are ``target``
     of them (see the module docstring), or until the bodies' total volume is within
-    ``1 + max_excess`` of the part's. The leaves' tree nodes get planes and children."""
+    ``1 + max_excess`` of the part's; with a finite ``ceiling``, only by cuts that leave
+    the total at most that (:meth:`_Search.best_cut_within`; no sequences of two). The
+    leaves' tree nodes get planes and children."""
     growth = _Growth(root, list(leaves), "", {len(leaves): search.union(leaves)})
     leaves = growth.leaves
     while len(leaves) < target:
@@ -713,8 +1002,15 @@ def _grow(
             total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
             if total <= (1.0 + max_excess) * search.solid.volume:
                 break
-        union, k, normal, offset = search.best_cut(leaves)
-        if union < growth.union:
+        if math.isfinite(ceiling):
+            found = search.best_cut_within(leaves, growth.union, ceiling)
+            if found is None:
+                why = "no cut made the cover smaller within the reflex pieces' total"
+                growth.note = _stopped(len(leaves), why)
+                break
+            union, k, normal, offset, children = found
+        elif (cut := search.best_cut(leaves))[0] < growth.union:
+            union, k, normal, offset = cut
             children = search.children(leaves[k], normal, offset)
         elif len(leaves) + 2 > target or not LOOKAHEAD or search.cuts == "vertices":
             growth.note = _stopped(len(leaves), "no cut made the cover smaller")
