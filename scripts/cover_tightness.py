@@ -12,7 +12,7 @@ The default meshes are the Panda hand, link0 and link3 and the UR5 upper arm and
 collision meshes (``../shared/data/external/example-robot-data``) and the L-bracket CAD
 part of the suite; ``--meshes`` gives others. Then come the generated parts of
 :mod:`kcplan.cover.profiles` (a thick ring, a U-channel made two ways, a T-profile, a
-pipe), chosen by ``--profiles``.
+pipe, and the I, H, T, L, Z and C sections as unions of slabs), chosen by ``--profiles``.
 """
 
 from __future__ import annotations
