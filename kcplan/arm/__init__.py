@@ -4,7 +4,8 @@
 each link is its collision mesh's convex hull (:mod:`kcplan.arm.hulls`), or, asked for,
 covered by ellipsoids (:mod:`kcplan.cover`); parts can be attached to a link
 (:mod:`kcplan.arm.attach`) and pairs of links proven never to touch are left out
-(:mod:`kcplan.arm.pairs`);
+(:mod:`kcplan.arm.pairs`); an SRDF's planning groups and named states choose the joints
+and the states (:mod:`kcplan.arm.srdf`);
 :mod:`kcplan.arm.kinematics` computes joint and body frames from it, and
 :mod:`kcplan.arm.bounds` bounds how far its bodies move along a joint-space edge.
 """

@@ -4,11 +4,12 @@ The format (``scenarios/README.md``)::
 
     name: box_1
     robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,   # or example: NAME
-            joints: [panda_joint1, ..., panda_joint7], fixed: {NAME: VALUE},
+            joints: [panda_joint1, ..., panda_joint7],        # or group: panda_arm
+            fixed: {NAME: VALUE},
             package_dirs: [DIR], representation: hulls, bodies_per_link: K,
             max_offset: E, inflation: 0.0}
     start: {joints: [...]}            # the group's values, in ``joints`` order
-    goal: {joints: [...]}
+    goal: {state: ready}              # or a named state of the SRDF (group_state)
     obstacles: [{box: {center, size, quaternion}}, {cylinder: {center, quaternion,
                  radius, height}}, {sphere: ...}, {ellipsoid: ...}, {convex: ...},
                  {mesh: ...}]
@@ -24,6 +25,10 @@ has one, and its arm's joints unless ``joints`` is given) instead of ``urdf``.
 ``ROS_PACKAGE_PATH`` and example-robot-data's share folder
 (:func:`kcplan.arm.model.package_folders`). ``joints`` is the planning group in state
 order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm`).
+``group`` instead names one of the SRDF's planning groups (its joints in the URDF's
+order, :mod:`kcplan.arm.srdf`), and a start or goal may be one of the SRDF's named
+states (``state: NAME``: the group's ``group_state``, or with ``joints`` a state of any
+group that sets every joint of the planning group).
 ``representation`` is ``hulls`` (each link its own convex hull, the default) or
 ``ellipsoids`` (covers; the default when ``bodies_per_link`` or ``max_offset`` is given).
 ``max_offset`` (metres) cuts each link's cover until it sticks out of the link's mesh by
@@ -40,8 +45,9 @@ the rigid format's one-line errors (:class:`kcplan.world.fields.ScenarioError`).
 from __future__ import annotations
 
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +58,7 @@ from kcplan.arm.attach import Attached, attach
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
+from kcplan.arm.srdf import Srdf, read_srdf
 from kcplan.world.fields import FieldReader, ScenarioError, read_padding
 from kcplan.world.obstacles import MAX_OBSTACLES, Obstacle, parse_obstacle, self_filtered
 from kcplan.world.pointcloud import ellipsoid_self_filter_mask, hull_self_filter_mask
@@ -106,8 +113,17 @@ def _cylinder(r: FieldReader, spec: Any, index: int) -> Obstacle:
     return Obstacle("cylinder", index, spec, center, R, np.array([radius, radius, 0.5 * height]))
 
 
-def _joints(r: FieldReader, value: Any, where: str, arm: ArmModel) -> NDArray[np.float64]:
-    spec = r.mapping(value, where, ("joints",))
+def _joints(
+    r: FieldReader, value: Any, where: str, arm: ArmModel,
+    states: Callable[[str, str], dict[str, float]],
+) -> NDArray[np.float64]:  # fmt: skip
+    spec = r.mapping(value, where, (), ("joints", "state"))
+    if ("joints" in spec) == ("state" in spec):
+        r.fail(where, "joints (a list of values) or state (a named state of the SRDF)", None,
+               "both" if spec else "neither")  # fmt: skip
+    if "state" in spec:
+        values = states(r.text(spec["state"], f"{where}.state"), f"{where}.state")
+        spec = {"joints": [values[name] for name in arm.joints]}
     q = r.vector(spec["joints"], f"{where}.joints", arm.dof)
     q, clamped, outside = arm.clamp(q)
     if outside:
@@ -140,8 +156,9 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         r.fail("dimension", "3 (an arm moves in 3D), or no dimension", top["dimension"])
     spec = r.mapping(
         top["robot"], "robot", (),
-        ("urdf", "example", "joints", "srdf", "fixed", "package_dirs", "representation",
-         "bodies_per_link", "max_offset", "inflation", "padding", "link_padding"),
+        ("urdf", "example", "joints", "group", "srdf", "fixed", "package_dirs",
+         "representation", "bodies_per_link", "max_offset", "inflation", "padding",
+         "link_padding"),
     )  # fmt: skip
     if ("urdf" in spec) == ("example" in spec):
         r.fail("robot", "a urdf (a file) or an example (a robot of example-robot-data)",
@@ -153,16 +170,23 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             raise ScenarioError(f"{source}: {err}") from None
         if "srdf" in spec:
             srdf = directory / r.text(spec["srdf"], "robot.srdf")
-        spec.setdefault("joints", list(default_joints))
+        if "group" not in spec:
+            spec.setdefault("joints", list(default_joints))
     else:
         urdf = directory / r.text(spec["urdf"], "robot.urdf")
         srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
-        if "joints" not in spec:
-            r.fail("robot.joints", "the planning group: a list of joint names", None, "none")
+        if "joints" not in spec and "group" not in spec:
+            r.fail("robot.joints", "the planning group: a list of joint names (or group: a "
+                   "group of the SRDF)", None, "none")  # fmt: skip
     for key, path in (("urdf", urdf), ("srdf", srdf)):
         if path is not None and not path.is_file():
             r.fail(f"robot.{key}", f"an existing {key.upper()} file (relative to the scenario)",
                    None, f"{spec.get(key)!r}, which does not exist at {path}")  # fmt: skip
+    semantic = _Semantic(r, urdf, srdf)
+    if "group" in spec:
+        if "joints" in spec:
+            r.fail("robot.group", "a group or joints, not both", spec["group"])
+        spec["joints"] = list(semantic.joints(r.text(spec["group"], "robot.group")))
     joints = spec["joints"]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         r.fail("robot.joints", "a list of joint names", joints)
@@ -208,7 +232,8 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             arm = attach(arm, held)
         except ArmError as err:
             raise ScenarioError(f"{source}: {err}") from None
-    start, goal = (_joints(r, top[key], key, arm) for key in ("start", "goal"))
+    states = partial(semantic.state, spec.get("group"), arm.joints)
+    start, goal = (_joints(r, top[key], key, arm, states) for key in ("start", "goal"))
     items = top.get("obstacles") or []
     if not isinstance(items, list):
         r.fail("obstacles", "a list of obstacles", items)
@@ -228,6 +253,44 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         name, arm, start, goal, tuple(obstacles), allowed, dict(spec), inflation,
         description, source, directory, read_padding(r, spec), _link_padding(r, spec, arm),
     )  # fmt: skip
+
+
+class _Semantic:
+    """The scenario's SRDF, read when a group or a named state asks for it."""
+
+    def __init__(self, r: FieldReader, urdf: Path, srdf: Path | None) -> None:
+        self._r, self._urdf, self._srdf, self._read = r, urdf, srdf, None
+
+    def _srdf_of(self, field: str) -> Srdf:
+        if self._srdf is None:
+            self._r.fail(field, "an SRDF to read it from (robot.srdf)", None, "no SRDF")
+        if self._read is None:
+            try:
+                self._read = read_srdf(self._srdf)
+            except ArmError as err:
+                raise ScenarioError(f"{self._r.source}: robot: {err}") from None
+        return self._read
+
+    def joints(self, group: str) -> tuple[str, ...]:
+        import pinocchio as pin
+
+        srdf = self._srdf_of("robot.group")
+        try:
+            return srdf.group_joints(group, pin.buildModelFromUrdf(str(self._urdf)))
+        except (RuntimeError, ValueError) as err:  # Pinocchio cannot read the URDF
+            if isinstance(err, ArmError):
+                raise ScenarioError(f"{self._r.source}: robot: {err}") from None
+            raise ScenarioError(f"{self._r.source}: robot.urdf: expected a readable URDF, "
+                                f"got: {err}") from None  # fmt: skip
+
+    def state(self, group: str | None, joints: tuple[str, ...], name: str,
+              where: str) -> dict[str, float]:  # fmt: skip
+        """Named state ``name``: of ``group``, or else of any group that sets ``joints``."""
+        srdf = self._srdf_of(where)
+        try:
+            return srdf.state(name, joints, group)
+        except ArmError as err:
+            raise ScenarioError(f"{self._r.source}: {where}: {err}") from None
 
 
 def _link_padding(r: FieldReader, spec: dict, arm: ArmModel) -> dict[str, float]:

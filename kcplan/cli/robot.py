@@ -112,23 +112,33 @@ def run_info(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     import numpy as np
+    import pinocchio as pin
 
     from kcplan.arm import ArmError, load_arm
     from kcplan.arm.model import movable_joints
     from kcplan.arm.pairs import prove_pairs
+    from kcplan.arm.srdf import read_srdf
 
     for key, path in (("urdf", args.urdf), ("srdf", args.srdf)):
         if path is not None and not Path(path).is_file():
             raise InputError(f"{path}: {key}: expected an existing {key.upper()} file")
+    if args.group is not None and args.srdf is None:
+        raise InputError("--group: expected --srdf (the SRDF that defines the group)")
     t0 = time.perf_counter()
     try:
-        joints = args.joints or movable_joints(args.urdf)  # every movable joint, in order
+        srdf = None if args.srdf is None else read_srdf(args.srdf)
+        if args.group is not None:
+            joints = srdf.group_joints(args.group, pin.buildModelFromUrdf(args.urdf))
+        else:
+            joints = args.joints or movable_joints(args.urdf)  # every movable joint, in order
         arm = load_arm(args.urdf, joints, srdf=args.srdf, package_dirs=args.package_dir)
     except ArmError as err:
         raise InputError(str(err)) from None
     took = time.perf_counter() - t0
     print(f"{args.urdf}: {arm.dof} joints in the group, {len(arm.bodies)} bodies "
           f"(links as their convex hulls), read in {took:.1f} s")  # fmt: skip
+    if srdf is not None:
+        _print_srdf(srdf, pin.buildModelFromUrdf(args.urdf))
     print("joints (state order): name, kind, limits")
     for name, kind, lo, hi in zip(arm.joints, arm.kinds, arm.lower, arm.upper, strict=True):
         print(f"  {name}: {kind} [{float(lo)!r}, {float(hi)!r}]")
@@ -158,6 +168,28 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"in contact at every configuration tried (32 random ones within the limits): "
               f"{pairs}; a scenario must allow them: allowed: [{pairs}]")  # fmt: skip
     return 0
+
+
+def _print_srdf(srdf, model) -> None:
+    """The SRDF's planning groups (their joints, or why kcplan cannot plan one), named
+    states and virtual joints, for ``kcplan robot info``."""
+    from kcplan.arm import ArmError
+
+    print(f"groups ({srdf.source}): name: joints, in state order")
+    for name in srdf.groups:
+        try:
+            print(f"  {name}: {', '.join(srdf.group_joints(name, model))}")
+        except ArmError as err:  # said, not fatal: another group may be the one asked
+            # the message less its "SRDF: group 'NAME'" prefix, said on the line already
+            print(f"  {name}: not plannable: {str(err).split(': ', 2)[-1]}")
+    if srdf.states:
+        states = ", ".join(f"{state} ({group})" for group, state in srdf.states)
+        print(f"named states (group): {states}")
+    for v in srdf.virtual_joints:
+        print(
+            f"virtual joint {v.name}: {v.kind}, {v.parent_frame} to {v.child_link}"
+            + ("" if v.kind == "fixed" else " (kcplan plans the base fixed)")
+        )
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -212,16 +244,21 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     fit.set_defaults(handler=run_fit)
     info = actions.add_parser(
         "info",
-        help="what kcplan makes of a URDF arm: joints, limits, bodies, self pairs",
-        description="Read a URDF arm (Pinocchio) as kcplan plans it: the planning group's "
+        help="what kcplan makes of a URDF arm: groups, joints, limits, bodies, self pairs",
+        description="Read a URDF arm (Pinocchio) as kcplan plans it: the SRDF's groups, named "
+        "states and virtual joints, the planning group's "
         "joints and limits, each link's body (its convex hull), and the self pairs: those "
         "proven apart over the joint box (never checked), those that can touch and those "
         "not decided (checked). Exit 0 done, 2 bad input.",
     )
     info.add_argument("urdf", metavar="URDF")
-    info.add_argument("--srdf", metavar="SRDF", help="its disabled pairs are never checked")
-    info.add_argument("--joints", nargs="+", metavar="JOINT",
-                      help="the planning group (default: every movable joint)")  # fmt: skip
+    info.add_argument("--srdf", metavar="SRDF",
+                      help="its disabled pairs are never checked; its groups, named states "
+                      "and virtual joints are listed")  # fmt: skip
+    chosen = info.add_mutually_exclusive_group()
+    chosen.add_argument("--joints", nargs="+", metavar="JOINT",
+                        help="the planning group (default: every movable joint)")  # fmt: skip
+    chosen.add_argument("--group", metavar="NAME", help="the planning group: a group of --srdf")
     info.add_argument("--package-dir", action="append", metavar="DIR",
                       help="a folder of packages of package:// mesh URIs (repeatable)")  # fmt: skip
     info.set_defaults(handler=run_info)
