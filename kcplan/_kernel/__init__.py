@@ -242,7 +242,7 @@ def build_kernel_arm(world) -> _core.ArmWorld:
     pairs = [(int(k), int(m)) for k, m in world.self_pairs]
     kernel = _core.ArmWorld(kernel_chain(world.arm), pairs, COAL_CLEARANCE_RTOL, atol)
     kernel.scene.padding = float(world.padding)
-    own = getattr(world, "link_padding", {})  # a link's own padding, for its bodies
+    own = world.link_padding  # a link's own padding, for its bodies
     for k, body in enumerate(world.arm.bodies):
         if body.link in own:
             kernel.scene.set_body_padding(k, float(own[body.link]))
