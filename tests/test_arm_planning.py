@@ -132,6 +132,37 @@ def test_the_mesh_checker_measures_far_links_by_their_hulls_from_below(panda, sc
     assert by_hull > 50  # the hulls do serve
 
 
+def test_the_mesh_checker_reads_what_trimesh_cannot_as_pinocchio_read_it(panda, scene,
+                                                                          monkeypatch):  # fmt: skip
+    """A mesh format trimesh cannot read here (Collada without pycollada: Baxter's,
+    TIAGo's) is measured on the triangles Pinocchio read (assimp), not refused with a
+    traceback: for the Panda's STL files both loaders give the same distances (within
+    10 µm: assimp keeps single precision, and FCL's GJK stops at its own tolerance)."""
+    import trimesh
+
+    import kcplan.arm.verify as verify
+
+    _, obstacles = scene
+    by_trimesh = ArmMeshChecker(panda, obstacles)
+    verify._file_mesh.cache_clear()
+
+    def cannot(*args, **kwargs):
+        raise ImportError("missing `pip install pycollada`")
+
+    monkeypatch.setattr(trimesh, "load", cannot)
+    by_pinocchio = ArmMeshChecker(panda, obstacles)
+    monkeypatch.undo()
+    verify._file_mesh.cache_clear()
+    assert all(h is not None for h in by_pinocchio._hulls[:8])  # the links' hulls too
+    items = range(len(by_trimesh._links) + len(by_trimesh._pairs))
+    rng = np.random.default_rng(3)
+    for _ in range(6):
+        q = rng.uniform(panda.lower, panda.upper)
+        by_trimesh._place(q), by_pinocchio._place(q)
+        for i in items:
+            assert by_pinocchio._distance(i) == pytest.approx(by_trimesh._distance(i), abs=1e-5)
+
+
 def test_an_edge_that_meets_the_scene_midway_is_rejected(panda, scene):
     """Both ends free (covers and meshes), the meshes in contact near s = 0.59."""
     world, obstacles = scene

@@ -71,26 +71,31 @@ class ArmPathCheck:
 
 
 @functools.lru_cache(maxsize=256)
-def _mesh(path: str, scale: tuple[float, float, float]) -> tuple[fcl.BVHModel, float]:
-    """A collision mesh file as an FCL BVH model (scaled), and its farthest vertex's
-    distance from the mesh's origin; loaded once per process (the model is shared by the
-    collision objects that place it)."""
-    mesh = trimesh.load(path, force="mesh", process=False)
+def _file_mesh(path: str, scale: tuple[float, float, float]):
+    """A collision mesh file as trimesh reads it (scaled): its FCL BVH model, its farthest
+    vertex's distance from the mesh's origin and its convex hull (:func:`_convex_hull`);
+    ``None`` for a format trimesh cannot read here (Collada without pycollada). Loaded
+    once per process (the model is shared by the collision objects that place it)."""
+    try:
+        mesh = trimesh.load(path, force="mesh", process=False)
+    except (ImportError, ValueError, OSError):  # as the views (kcplan.views.arm) fall back
+        return None
     V = np.asarray(mesh.vertices, dtype=float) * np.asarray(scale, dtype=float)
-    F = np.asarray(mesh.faces, dtype=np.int32)
+    return (*_bvh_model(V, np.asarray(mesh.faces)), _convex_hull(V))
+
+
+def _bvh_model(V: NDArray[np.float64], F: NDArray) -> tuple[fcl.BVHModel, float]:
+    """Triangles as an FCL BVH model, and the farthest vertex's distance from the origin."""
     model = fcl.BVHModel()
     model.beginModel(len(V), len(F))
-    model.addSubModel(V, F)
+    model.addSubModel(V, F.astype(np.int32))
     model.endModel()
     return model, float(np.linalg.norm(V, axis=1).max())
 
 
-@functools.lru_cache(maxsize=256)
-def _hull(path: str, scale: tuple[float, float, float]) -> fcl.Convex | None:
-    """The convex hull of a collision mesh file (scaled) as an FCL solid, ``None`` when
-    qhull cannot build one (a flat mesh)."""
-    mesh = trimesh.load(path, force="mesh", process=False)
-    V = np.asarray(mesh.vertices, dtype=float) * np.asarray(scale, dtype=float)
+def _convex_hull(V: NDArray[np.float64]) -> fcl.Convex | None:
+    """The convex hull of points as an FCL solid, ``None`` when qhull cannot build one (a
+    flat mesh)."""
     try:
         hull = trimesh.convex.convex_hull(V)
     except Exception:  # qhull's errors on flat input are of several kinds
@@ -99,33 +104,34 @@ def _hull(path: str, scale: tuple[float, float, float]) -> fcl.Convex | None:
     return fcl.Convex(np.asarray(hull.vertices, dtype=float), len(hull.faces), faces)
 
 
-def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float]:
-    """The FCL geometry of one collision object of Pinocchio and the farthest any point of
-    it lies from its own frame's origin."""
+def _link_geometry(obj) -> tuple[fcl.CollisionGeometry, float, fcl.Convex | None]:
+    """The FCL geometry of one collision object of Pinocchio, the farthest any point of it
+    lies from its own frame's origin, and a mesh file's convex hull (else None).
+
+    A mesh file is read by trimesh, independently of the loader the hulls were made
+    from; a format it cannot read here is taken as Pinocchio read it (assimp)."""
     shape, kind = obj.geometry, type(obj.geometry).__name__
     if kind == "Sphere":
-        return fcl.Sphere(float(shape.radius)), float(shape.radius)
+        return fcl.Sphere(float(shape.radius)), float(shape.radius), None
     if kind == "Box":
         h = np.asarray(shape.halfSide, dtype=float)
-        return fcl.Box(*(2 * h).tolist()), float(np.linalg.norm(h))
+        return fcl.Box(*(2 * h).tolist()), float(np.linalg.norm(h)), None
     if kind == "Cylinder":
         r, c = float(shape.radius), float(shape.halfLength)
-        return fcl.Cylinder(r, 2 * c), math.hypot(r, c)
+        return fcl.Cylinder(r, 2 * c), math.hypot(r, c), None
     if not obj.meshPath:  # a mesh given by its triangles (an attached object's)
-        return _bvh(shape)
-    return _mesh(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
+        return (*_bvh(shape), None)
+    read = _file_mesh(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
+    if read is None:
+        V, F = bvh_mesh(shape)
+        return (*_bvh_model(V, F), _convex_hull(V))
+    return read
 
 
 def _bvh(shape) -> tuple[fcl.BVHModel, float]:
     """A coal BVH model's triangles as an FCL BVH model, and its farthest vertex's
     distance from its origin."""
-    V, F = bvh_mesh(shape)
-    F = F.astype(np.int32)
-    model = fcl.BVHModel()
-    model.beginModel(len(V), len(F))
-    model.addSubModel(V, F)
-    model.endModel()
-    return model, float(np.linalg.norm(V, axis=1).max())
+    return _bvh_model(*bvh_mesh(shape))
 
 
 class ArmMeshChecker:
@@ -174,13 +180,8 @@ class ArmMeshChecker:
         self.arm, self.tolerance, self.padding = arm, float(tolerance), float(padding)
         self._links, self._hulls, reaches, joints = [], [], [], []
         for obj in geometry.geometryObjects:
-            shape, reach = _link_geometry(obj)
+            shape, reach, hull = _link_geometry(obj)
             self._links.append(fcl.CollisionObject(shape, fcl.Transform()))
-            hull = (
-                _hull(str(obj.meshPath), tuple(float(x) for x in obj.meshScale))
-                if isinstance(shape, fcl.BVHModel) and obj.meshPath
-                else None
-            )
             self._hulls.append(None if hull is None else fcl.CollisionObject(hull, fcl.Transform()))
             # the geometry's points lie within its placement's length plus its own reach
             reaches.append(float(np.linalg.norm(obj.placement.translation)) + reach)

@@ -163,6 +163,7 @@ def run_info(args: argparse.Namespace) -> int:
     checker = ArmMeshChecker(arm, [])
     always = [p.links for p in proofs
               if p.verdict == "touches" and checker.contact_share(p.links) == 1.0]  # fmt: skip
+    always = list(dict.fromkeys(always))  # a pair of links with several geometries: once
     if always:  # no plan can separate them: the SRDF misses them
         pairs = ", ".join(f"[{a}, {b}]" for a, b in always)
         print(f"in contact at every configuration tried (32 random ones within the limits): "
