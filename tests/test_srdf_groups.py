@@ -139,6 +139,13 @@ def test_a_scenario_plans_a_group_between_named_states(tmp_path):
     assert scenario.arm.joints == ARM
     ready = srdf.state("ready", ARM)
     np.testing.assert_allclose(scenario.start, [ready[j] for j in ARM])
+    # written back with its group (and the states as values), it reads the same
+    from kcplan.scenarios import dump_scenario
+
+    dump_scenario(scenario, tmp_path / "again.yaml")
+    again = load_scenario(tmp_path / "again.yaml")
+    assert again.arm.joints == ARM and again.robot_spec["group"] == "panda_arm"
+    np.testing.assert_allclose(again.start, scenario.start)
     from kcplan.cli import main
 
     path = _scenario(tmp_path, f"srdf: {PANDA / 'panda.srdf'}, group: panda_arm",

@@ -183,11 +183,12 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             r.fail(f"robot.{key}", f"an existing {key.upper()} file (relative to the scenario)",
                    None, f"{spec.get(key)!r}, which does not exist at {path}")  # fmt: skip
     semantic = _Semantic(r, urdf, srdf)
-    if "group" in spec:
+    if "group" in spec:  # the spec keeps the group (written back as it was read)
         if "joints" in spec:
             r.fail("robot.group", "a group or joints, not both", spec["group"])
-        spec["joints"] = list(semantic.joints(r.text(spec["group"], "robot.group")))
-    joints = spec["joints"]
+        joints = list(semantic.joints(r.text(spec["group"], "robot.group")))
+    else:
+        joints = spec["joints"]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         r.fail("robot.joints", "a list of joint names", joints)
     folders = spec.get("package_dirs", [])
