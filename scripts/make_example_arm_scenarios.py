@@ -10,6 +10,11 @@ kept only when ``kc-rrtconnect`` (seed 1) plans between them and its path is fre
 meshes. Writes ``DIR/example_NAME.yaml`` for each arm (``scenarios/arm`` by default)::
 
     python scripts/make_example_arm_scenarios.py [--arms ur3,ur10,xarm7] [--seed 1] [-o DIR]
+
+A robot with two arms (``--arms baxter``, :data:`HANDS`) gets a hand-over instead: a
+table in front of it with a post in its middle, a start with both hands held out to the
+sides and a goal with the two hands within 0.3 m of each other above the table, both
+arms moving at once.
 """
 
 from __future__ import annotations
@@ -103,6 +108,69 @@ def make(name: str, seed: int, folder: Path) -> Path:
     raise SystemExit(f"{name}: kc-rrtconnect solved no start and goal pair tried")
 
 
+HANDS = {"baxter": ("left_gripper_base_link", "right_gripper_base_link")}
+"""The two hands' links of each robot with two arms (:func:`make_handover`)."""
+
+
+def make_handover(name: str, seed: int, folder: Path) -> Path:
+    """Write a two-armed robot's hand-over scenario (module docstring); its path."""
+    data = {
+        "name": f"example_{name}",
+        "description": f"example-robot-data's {name} hands over: both arms at once, from "
+        "held out to the sides to meet above a table, round a post "
+        "(scripts/make_example_arm_scenarios.py).",
+        "robot": {"example": name},
+        "start": {"joints": []},
+        "goal": {"joints": []},
+        "obstacles": [
+            {"box": {"center": [0.8, 0.0, -0.2], "size": [0.6, 1.2, 0.04]}},
+            {"cylinder": {"center": [0.8, 0.0, 0.05], "radius": 0.04, "height": 0.46}},
+        ],
+    }
+    path = folder / f"example_{name}.yaml"
+    urdf, srdf, joints = example_robot(name)
+    arm = load_arm(urdf, joints, srdf=srdf)
+    scenario = parse_scenario({**data, "start": {"joints": [0.0] * arm.dof},
+                               "goal": {"joints": [0.0] * arm.dof}}, str(path), folder,
+                              check=False)  # fmt: skip
+    world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
+    hands = [[i for i, b in enumerate(arm.bodies) if b.link == link][0] for link in HANDS[name]]
+
+    def wanted(q, goal: bool) -> bool:
+        left, right = (body_frames(arm, q)[i][:3, 3] for i in hands)
+        if goal:  # the hands together above the table
+            low, high = min(left[2], right[2]), max(left[2], right[2])
+            return (np.linalg.norm(left - right) < 0.3 and min(left[0], right[0]) > 0.55
+                    and -0.1 < low and high < 0.35)  # fmt: skip
+        return left[1] > 0.55 and right[1] < -0.55 and min(left[2], right[2]) > 0.0
+
+    rng = np.random.default_rng(seed)
+    found = {}
+    for _ in range(40000):
+        q = rng.uniform(arm.lower, arm.upper)
+        role = "goal" if "goal" not in found else "start"
+        if not wanted(q, role == "goal") or world.in_collision(q):
+            continue
+        if verify_arm_path(arm, scenario.obstacles, [q, q], allowed=scenario.allowed).collides:
+            continue
+        found[role] = [round(float(v), 4) for v in q]
+        if len(found) == 2:
+            break
+    if len(found) < 2:
+        raise SystemExit(f"{name}: no free {'start' if found else 'goal'} found")
+    data["start"]["joints"], data["goal"]["joints"] = found["start"], found["goal"]
+    scenario = parse_scenario(data, str(path), folder, check=False)
+    result = plan(scenario, seed=1, time_limit=10.0)
+    if not result.solved:
+        raise SystemExit(f"{name}: the default planner solved no hand-over")
+    q = np.array(result.states).reshape(-1, arm.dof)
+    if verify_arm_path(arm, scenario.obstacles, q, allowed=scenario.allowed).collides:
+        raise SystemExit(f"{name}: the hand-over's path is not free on the meshes")
+    dump_scenario(data, path)
+    print(f"{path}: a hand-over of {arm.dof} joints, solved in {result.time:.3f} s")
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--arms", default="ur3,ur10,xarm7")
@@ -112,7 +180,7 @@ def main(argv: list[str] | None = None) -> int:
     folder = Path(args.output)
     folder.mkdir(parents=True, exist_ok=True)
     for name in args.arms.split(","):
-        make(name, args.seed, folder)
+        (make_handover if name in HANDS else make)(name, args.seed, folder)
     return 0
 
 

@@ -38,10 +38,30 @@ def test_the_bundled_example_arms_plan_on_their_meshes(name):
 
 
 @needs_examples
+def test_two_arms_on_one_torso_plan_at_once(capsys):
+    """Baxter (issue 57 item 2): a tree of two branches, its 14 joints one group; the pairs
+    across the arms are checked, and the certified path of both arms at once is free on
+    the links' own meshes (Collada, read as Pinocchio read them)."""
+    scenario = load_scenario(ARM / "example_baxter.yaml")  # start and goal checked free
+    arm = scenario.arm
+    assert arm.joints == EXAMPLE_ARMS["baxter"][2] and arm.dof == 14
+    side = {i: b.link.split("_")[0] for i, b in enumerate(arm.bodies)}
+    across = [(i, j) for i, j in arm.self_pairs
+              if {side[i], side[j]} == {"left", "right"}]  # fmt: skip
+    assert len(across) >= 20  # left against right, both ways along the tree
+    result = plan(scenario, time_limit=20.0, seed=1)  # the default: the compiled lazy planner
+    assert result.solved
+    states = np.array(result.states).reshape(-1, arm.dof)
+    check = verify_arm_path(arm, scenario.obstacles, states, allowed=scenario.allowed)
+    assert not check.collides and check.queries > 0
+
+
+@needs_examples
 def test_an_example_is_a_checked_robot_field(tmp_path):
     base = {"name": "e", "start": {"joints": [0.0] * 6}, "goal": {"joints": [0.0] * 6}}
     for robot, message in (
-        ({"example": "nope"}, r"robot.example: expected one of panda, ur10, ur3, ur5, xarm7"),
+        ({"example": "nope"},
+         r"robot.example: expected one of baxter, panda, ur10, ur3, ur5, xarm7"),
         ({"example": "ur3", "urdf": "x.urdf"}, r"robot: expected a urdf .* or an example"),
     ):
         with pytest.raises(ScenarioError, match=message):

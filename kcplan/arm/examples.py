@@ -46,11 +46,19 @@ EXAMPLE_ARMS: dict[str, tuple[str, str | None, tuple[str, ...]]] = {
         ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
          "wrist_2_joint", "wrist_3_joint"),
     ),  # fmt: skip
+    # two arms on one torso (a tree: self pairs across its branches); its SRDF's disabled
+    # pairs hold, its groups name another robot's joints ("baxter/left_s0")
+    "baxter": (
+        "baxter_description/urdf/baxter.urdf",
+        "baxter_description/srdf/baxter_manipulation.srdf",
+        tuple(f"{side}_{joint}" for side in ("left", "right")
+              for joint in ("s0", "s1", "e0", "e1", "w0", "w1", "w2")),
+    ),  # fmt: skip
 }
 """Arms of example-robot-data 6.0.0 that kcplan plans: ``NAME: (URDF, SRDF or None, the
-arm's joints in state order)``, paths relative to :func:`example_folder`. Left out: the
-Kinova (continuous joints, no limits), the Z1 and the SO-100 (a link and a fixed joint of
-one name, which Pinocchio's ``buildReducedModel`` refuses)."""
+arm's joints in state order)``, paths relative to :func:`example_folder`; Baxter's are
+both arms. Left out: the Kinova (continuous joints, no limits), the Z1 and the SO-100 (a
+link and a fixed joint of one name, which Pinocchio's ``buildReducedModel`` refuses)."""
 
 
 def example_folder() -> Path:
