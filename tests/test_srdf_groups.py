@@ -177,7 +177,7 @@ def test_a_bad_group_or_state_in_a_scenario_exits_2(tmp_path, capsys, robot, sta
     assert "\n" not in err and message in err
 
 
-def test_robot_info_lists_the_groups_and_plans_one(capsys):
+def test_robot_info_lists_the_groups_and_plans_one(tmp_path, capsys):
     from kcplan.cli import main
 
     urdf, srdf = str(PANDA / "panda.urdf"), str(PANDA / "panda.srdf")
@@ -188,6 +188,11 @@ def test_robot_info_lists_the_groups_and_plans_one(capsys):
     assert "  hand: not plannable: expected at least one revolute or prismatic joint" in out
     assert "named states (group): ready (panda_arm), extended (panda_arm)" in out
     assert "virtual joint virtual_joint: floating, world to panda_link0" in out
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot")  # one line and exit 2 on the SRDF's path too, no traceback
+    assert main(["robot", "info", str(bad), "--srdf", srdf, "--group", "panda_arm"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "bad.urdf: urdf: expected a readable URDF" in err
     assert main(["robot", "info", urdf, "--group", "panda_arm"]) == 2
     assert (
         capsys.readouterr().err.strip()

@@ -76,6 +76,7 @@ __all__ = [
     "package_folders",
     "self_pairs_of",
     "movable_joints",
+    "urdf_model",
 ]
 
 DEFAULT_MAX_OFFSET = 0.01
@@ -286,9 +287,10 @@ class ArmModel(RobotModel):
         )
 
 
-def movable_joints(urdf: str | os.PathLike) -> list[str]:
-    """Every joint of the URDF that kcplan can move (revolute or prismatic), in the URDF's
-    order: the planning group when none is named.
+def urdf_model(urdf: str | os.PathLike):
+    """The URDF's whole joint tree, as Pinocchio reads it (``pinocchio.Model``, no joint
+    locked): what :func:`movable_joints` and an SRDF's groups
+    (:meth:`kcplan.arm.srdf.Srdf.group_joints`) are read against.
 
     Raises
     ------
@@ -298,9 +300,21 @@ def movable_joints(urdf: str | os.PathLike) -> list[str]:
     import pinocchio as pin
 
     try:
-        full = pin.buildModelFromUrdf(os.fspath(urdf))
+        return pin.buildModelFromUrdf(os.fspath(urdf))
     except (RuntimeError, ValueError, OSError) as err:
         raise ArmError(f"{urdf}: urdf: expected a readable URDF, got: {err}") from None
+
+
+def movable_joints(urdf: str | os.PathLike) -> list[str]:
+    """Every joint of the URDF that kcplan can move (revolute or prismatic), in the URDF's
+    order: the planning group when none is named.
+
+    Raises
+    ------
+    ArmError
+        ``URDF: urdf: expected a readable URDF, got: ...`` for a file Pinocchio cannot read.
+    """
+    full = urdf_model(urdf)
     return [n for n in full.names[1:] if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]
 
 

@@ -57,7 +57,14 @@ from numpy.typing import NDArray
 from kcplan.arm.attach import Attached, attach
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
-from kcplan.arm.model import LIMIT_TOLERANCE, REPRESENTATIONS, ArmError, ArmModel, load_arm
+from kcplan.arm.model import (
+    LIMIT_TOLERANCE,
+    REPRESENTATIONS,
+    ArmError,
+    ArmModel,
+    load_arm,
+    urdf_model,
+)
 from kcplan.arm.srdf import Srdf, read_srdf
 from kcplan.world.fields import FieldReader, ScenarioError, read_padding
 from kcplan.world.obstacles import MAX_OBSTACLES, Obstacle, parse_obstacle, self_filtered
@@ -273,16 +280,11 @@ class _Semantic:
         return self._read
 
     def joints(self, group: str) -> tuple[str, ...]:
-        import pinocchio as pin
-
         srdf = self._srdf_of("robot.group")
         try:
-            return srdf.group_joints(group, pin.buildModelFromUrdf(str(self._urdf)))
-        except (RuntimeError, ValueError) as err:  # Pinocchio cannot read the URDF
-            if isinstance(err, ArmError):
-                raise ScenarioError(f"{self._r.source}: robot: {err}") from None
-            raise ScenarioError(f"{self._r.source}: robot.urdf: expected a readable URDF, "
-                                f"got: {err}") from None  # fmt: skip
+            return srdf.group_joints(group, urdf_model(self._urdf))
+        except ArmError as err:  # the group, or a URDF Pinocchio cannot read
+            raise ScenarioError(f"{self._r.source}: robot: {err}") from None
 
     def state(self, group: str | None, joints: tuple[str, ...], name: str,
               where: str) -> dict[str, float]:  # fmt: skip

@@ -112,10 +112,9 @@ def run_info(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     import numpy as np
-    import pinocchio as pin
 
     from kcplan.arm import ArmError, load_arm
-    from kcplan.arm.model import movable_joints
+    from kcplan.arm.model import movable_joints, urdf_model
     from kcplan.arm.pairs import prove_pairs
     from kcplan.arm.srdf import read_srdf
 
@@ -127,8 +126,9 @@ def run_info(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         srdf = None if args.srdf is None else read_srdf(args.srdf)
+        full = None if srdf is None else urdf_model(args.urdf)  # the groups' joint tree
         if args.group is not None:
-            joints = srdf.group_joints(args.group, pin.buildModelFromUrdf(args.urdf))
+            joints = srdf.group_joints(args.group, full)
         else:
             joints = args.joints or movable_joints(args.urdf)  # every movable joint, in order
         arm = load_arm(args.urdf, joints, srdf=args.srdf, package_dirs=args.package_dir)
@@ -138,7 +138,7 @@ def run_info(args: argparse.Namespace) -> int:
     print(f"{args.urdf}: {arm.dof} joints in the group, {len(arm.bodies)} bodies "
           f"(links as their convex hulls), read in {took:.1f} s")  # fmt: skip
     if srdf is not None:
-        _print_srdf(srdf, pin.buildModelFromUrdf(args.urdf))
+        _print_srdf(srdf, full)
     print("joints (state order): name, kind, limits")
     for name, kind, lo, hi in zip(arm.joints, arm.kinds, arm.lower, arm.upper, strict=True):
         print(f"  {name}: {kind} [{float(lo)!r}, {float(hi)!r}]")
