@@ -835,7 +835,7 @@ class _Search:
         that leave the bodies' total volume at most ``most`` (each fitted as if chosen, in
         order of union, at most :data:`CEILING_TRIES` of them): ``(union volume, leaf
         index, normal, offset, children)``, or None."""
-        total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
+        total = _total(leaves)
         cuts = [
             (cut[0], k, j, cut[1], cut[2])
             for k in range(len(leaves))
@@ -938,7 +938,7 @@ def fit_cover(
         pieces = searches[0].pieces(bodies)
         if pieces is not None:
             # with a little room for rounding: the other trees' pieces fit as well
-            ceiling = sum(ellipsoid_volume(leaf.M) for leaf in pieces[1]) * (1.0 + 1e-9)
+            ceiling = _total(pieces[1]) * (1.0 + 1e-9)
             report = reporter("reflex pieces")
             growths.append(_grow(searches[0], *pieces, bodies, None, report, ceiling))
     if max_excess is None:
@@ -948,8 +948,7 @@ def fit_cover(
         growth = min((g for g in growths if g.total <= ceiling), key=lambda g: g.union)
     else:  # the fewest bodies within the bound, then the smallest union
         growth = min(growths, key=lambda g: (len(g.leaves), g.union))
-        total = sum(ellipsoid_volume(leaf.M) for leaf in growth.leaves)
-        if len(growth.leaves) == MAX_BODIES and total > (1.0 + max_excess) * solid.volume:
+        if len(growth.leaves) == MAX_BODIES and growth.total > (1.0 + max_excess) * solid.volume:
             growth.note = f"stopped at {MAX_BODIES} bodies, the most a robot may have"
     out = []
     for k, leaf in enumerate(growth.leaves):
@@ -978,7 +977,13 @@ class _Growth:
     @property
     def total(self) -> float:
         """The leaves' ellipsoids' total volume."""
-        return sum(ellipsoid_volume(leaf.M) for leaf in self.leaves)
+        return _total(self.leaves)
+
+
+def _total(leaves: list[_Leaf]) -> float:
+    """The total volume of the leaves' ellipsoids (the bound :attr:`Cover.volume_bound`
+    reports)."""
+    return sum(ellipsoid_volume(leaf.M) for leaf in leaves)
 
 
 def _grow(
@@ -999,8 +1004,7 @@ def _grow(
     leaves = growth.leaves
     while len(leaves) < target:
         if max_excess is not None:
-            total = sum(ellipsoid_volume(leaf.M) for leaf in leaves)
-            if total <= (1.0 + max_excess) * search.solid.volume:
+            if _total(leaves) <= (1.0 + max_excess) * search.solid.volume:
                 break
         if math.isfinite(ceiling):
             found = search.best_cut_within(leaves, growth.union, ceiling)
