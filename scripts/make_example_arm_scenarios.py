@@ -28,7 +28,7 @@ import numpy as np
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
-from kcplan.arm.verify import verify_arm_path
+from kcplan.arm.verify import ArmMeshChecker, verify_arm_path
 from kcplan.planning.problem import plan
 from kcplan.scenarios import dump_scenario, parse_scenario
 
@@ -128,12 +128,13 @@ def make_handover(name: str, seed: int, folder: Path) -> Path:
         ],
     }
     path = folder / f"example_{name}.yaml"
-    urdf, srdf, joints = example_robot(name)
-    arm = load_arm(urdf, joints, srdf=srdf)
-    scenario = parse_scenario({**data, "start": {"joints": [0.0] * arm.dof},
-                               "goal": {"joints": [0.0] * arm.dof}}, str(path), folder,
+    dof = len(example_robot(name)[2])
+    zeros = {"joints": [0.0] * dof}
+    scenario = parse_scenario({**data, "start": zeros, "goal": zeros}, str(path), folder,
                               check=False)  # fmt: skip
+    arm = scenario.arm
     world = ArmWorld(arm, scenario.obstacles, allowed=scenario.allowed)
+    meshes = ArmMeshChecker(arm, scenario.obstacles, scenario.allowed)  # built once
     hands = [[i for i, b in enumerate(arm.bodies) if b.link == link][0] for link in HANDS[name]]
 
     def wanted(q, goal: bool) -> bool:
@@ -151,7 +152,7 @@ def make_handover(name: str, seed: int, folder: Path) -> Path:
         role = "goal" if "goal" not in found else "start"
         if not wanted(q, role == "goal") or world.in_collision(q):
             continue
-        if verify_arm_path(arm, scenario.obstacles, [q, q], allowed=scenario.allowed).collides:
+        if meshes.check([q, q]).collides:
             continue
         found[role] = [round(float(v), 4) for v in q]
         if len(found) == 2:
@@ -164,7 +165,7 @@ def make_handover(name: str, seed: int, folder: Path) -> Path:
     if not result.solved:
         raise SystemExit(f"{name}: the default planner solved no hand-over")
     q = np.array(result.states).reshape(-1, arm.dof)
-    if verify_arm_path(arm, scenario.obstacles, q, allowed=scenario.allowed).collides:
+    if meshes.check(q).collides:
         raise SystemExit(f"{name}: the hand-over's path is not free on the meshes")
     dump_scenario(data, path)
     print(f"{path}: a hand-over of {arm.dof} joints, solved in {result.time:.3f} s")

@@ -38,7 +38,7 @@ def test_the_bundled_example_arms_plan_on_their_meshes(name):
 
 
 @needs_examples
-def test_two_arms_on_one_torso_plan_at_once(capsys):
+def test_two_arms_on_one_torso_plan_at_once():
     """Baxter (issue 57 item 2): a tree of two branches, its 14 joints one group; the pairs
     across the arms are checked, and the certified path of both arms at once is free on
     the links' own meshes (Collada, read as Pinocchio read them)."""
