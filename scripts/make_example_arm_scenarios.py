@@ -28,7 +28,7 @@ import numpy as np
 from kcplan.arm import ArmWorld, load_arm
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
-from kcplan.arm.verify import ArmMeshChecker, verify_arm_path
+from kcplan.arm.verify import ArmMeshChecker
 from kcplan.planning.problem import plan
 from kcplan.scenarios import dump_scenario, parse_scenario
 
@@ -82,13 +82,14 @@ def make(name: str, seed: int, folder: Path) -> Path:
     }
     obstacles = parse_scenario(data, "scene", folder, check=False).obstacles
     world = ArmWorld(arm, obstacles)
+    meshes = ArmMeshChecker(arm, obstacles)  # built once, for every state and path
     ends = frames[:, -1, :3, 3]
     picks = []
     for low, high in regions(reach):
         inside = np.flatnonzero(((ends >= low) & (ends <= high)).all(axis=1))
         free = [i for i in inside[:400] if not world.in_collision(states[i])]
         free = [i for i in free[:40]
-                if not verify_arm_path(arm, obstacles, [states[i]] * 2).collides]  # fmt: skip
+                if not meshes.check([states[i]] * 2).collides]  # fmt: skip
         if not free:
             raise SystemExit(f"{name}: no free state found in {low.round(3)}..{high.round(3)}")
         picks.append(free)
@@ -101,7 +102,7 @@ def make(name: str, seed: int, folder: Path) -> Path:
             result = plan(scenario, "kc-rrtconnect", time_limit=10.0, seed=1, simplify=False)
             if result.solved:
                 q = np.array(result.states).reshape(-1, arm.dof)
-                if not verify_arm_path(arm, obstacles, q).collides:
+                if not meshes.check(q).collides:
                     dump_scenario(data, path)
                     print(f"{path}: reach {reach:.3f} m, solved in {result.time:.3f} s")
                     return path
