@@ -61,7 +61,7 @@ def test_an_example_is_a_checked_robot_field(tmp_path):
     base = {"name": "e", "start": {"joints": [0.0] * 6}, "goal": {"joints": [0.0] * 6}}
     for robot, message in (
         ({"example": "nope"},
-         r"robot.example: expected one of baxter, panda, ur10, ur3, ur5, xarm7"),
+         r"robot.example: expected one of baxter, panda, pr2, ur10, ur3, ur5, xarm7"),
         ({"example": "ur3", "urdf": "x.urdf"}, r"robot: expected a urdf .* or an example"),
     ):
         with pytest.raises(ScenarioError, match=message):

@@ -230,6 +230,7 @@ def _build_chain(arm) -> _core.Chain:
         [float(v) for b in arm.bodies for v in b.semi_axes],
         [[] if b.hull is None else b.hull.vertices.ravel().tolist() for b in arm.bodies],
         [[] if b.hull is None else b.hull.triangles.ravel().tolist() for b in arm.bodies],
+        [] if arm.wraps is None else [bool(w) for w in arm.wraps],
     )  # fmt: skip
 
 

@@ -31,6 +31,7 @@ ArmCertifier::ArmCertifier(ArmWorld& world, const ArmCertifierOptions& options)
   speed_.resize(chain_.bodies().size());
   pair_speed_.resize(world.pairs().size());
   q_.resize(n_);
+  end_.resize(n_);
   caps_.resize(speed_.size());
   dq_.resize(n_);
   growth_.resize(speed_.size() * n_);
@@ -313,6 +314,7 @@ bool ArmCertifier::probe(const double* q1, const double* q2, double lo, double h
 bool ArmCertifier::screen(const double* q1, const double* q2, double step) {
   if (!(step > 0.0)) throw std::invalid_argument("screen: expected a step > 0");
   ++counters.screened_edges;
+  q2 = chain_.edge_end(q1, q2, end_.data());  // a wrapping angle turns the shorter way
   if (!chain_.admits(q1) || !chain_.admits(q2) || !state_valid(q2)) return false;
   double length = 0.0;
   for (int j = 0; j < n_; ++j) length += (q2[j] - q1[j]) * (q2[j] - q1[j]);
@@ -565,6 +567,7 @@ bool ArmCertifier::check_blend(const double* a, const double* c, const double* b
 bool ArmCertifier::check(const double* q1, const double* q2, bool with_probes) {
   CertifierCounters& c = counters;
   ++c.edges;
+  q2 = chain_.edge_end(q1, q2, end_.data());  // a wrapping angle turns the shorter way
   if (!chain_.admits(q1) || !chain_.admits(q2)) return reject(c.rejected_end_state);
   if (!state_valid(q2)) return reject(c.rejected_end_state);
   for (int j = 0; j < n_; ++j) q_[j] = q2[j] - q1[j];

@@ -279,6 +279,7 @@ class ArmCertifier {
   std::vector<double> rho_, rho_pairs_;
   std::vector<double> only_first_, only_second_;  // pairs x dof: joint carries one body only
   std::vector<double> speed_, q_, caps_, dq_, growth_, step_, accel_;
+  std::vector<double> end_;  // an edge's end, its wrapping angles unwrapped (Chain::edge_end)
   std::vector<double> body_growth_;  // per body: Q of the current edge (the sum of growth_)
   mutable std::vector<double> first_;  // A1 of the bodies at the guard of the radius asked
   std::vector<coal::Vec3s> w_, u_;     // their twists there (twist())

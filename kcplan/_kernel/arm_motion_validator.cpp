@@ -14,7 +14,7 @@ ScreenedArmMotions::ScreenedArmMotions(ArmCertifier& certifier, double step)
 }
 
 DiscreteArmMotions::DiscreteArmMotions(ArmWorld& world, double step)
-    : world_(world), step_(step), q_(world.chain().dof()) {
+    : world_(world), step_(step), q_(world.chain().dof()), end_(world.chain().dof()) {
   if (!(step > 0.0) || !std::isfinite(step))
     throw std::invalid_argument("joint step: expected a finite number > 0");
 }
@@ -26,6 +26,7 @@ bool DiscreteArmMotions::state_valid(const double* q) {
 
 bool DiscreteArmMotions::check(const double* q1, const double* q2) {
   ++edges;
+  q2 = world_.chain().edge_end(q1, q2, end_.data());  // the shorter turn, as OMPL's SO(2)
   if (!state_valid(q2)) return false;
   const int n = world_.chain().dof();
   double length = 0.0;

@@ -99,7 +99,7 @@ class DiscreteArmMotions final : public ArmMotionValidator {
  private:
   ArmWorld& world_;
   double step_;
-  std::vector<double> q_;
+  std::vector<double> q_, end_;
 };
 
 }  // namespace kcplan

@@ -16,13 +16,24 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-double distance(const double* a, const double* b, int n) {
+}  // namespace
+
+double ArmRRTConnect::squared(const double* a, const double* b) const {
   double d = 0.0;
-  for (int j = 0; j < n; ++j) d += (a[j] - b[j]) * (a[j] - b[j]);
-  return std::sqrt(d);
+  for (int j = 0; j < n_; ++j) {
+    const double e = chain_.difference(j, a[j], b[j]);
+    d += e * e;
+  }
+  return d;
 }
 
-}  // namespace
+double ArmRRTConnect::distance(const double* a, const double* b) const {
+  return std::sqrt(squared(a, b));
+}
+
+void ArmRRTConnect::between(const double* a, const double* b, double s, double* out) const {
+  for (int j = 0; j < n_; ++j) out[j] = chain_.canonical(j, a[j] + s * chain_.difference(j, a[j], b[j]));
+}
 
 ArmRRTConnect::ArmRRTConnect(const Chain& chain, ArmMotionValidator& tree,
                              ArmMotionValidator* path)
@@ -56,16 +67,16 @@ void ArmRRTConnect::nearest_in(const Tree& tree, int node, const double* q, std:
                                double& least) const {
   while (node >= 0) {
     const double* s = tree.states.data() + static_cast<std::size_t>(node) * n_;
-    double d = 0.0;
-    for (int j = 0; j < n_; ++j) d += (s[j] - q[j]) * (s[j] - q[j]);
+    const double d = squared(s, q);
     if (d < least) least = d, best = static_cast<std::size_t>(node);
     const int j = tree.depth[node] % n_;
     const double across = q[j] - s[j];
     const int near = across < 0.0 ? tree.below[node] : tree.above[node];
     const int far = across < 0.0 ? tree.above[node] : tree.below[node];
     nearest_in(tree, near, q, best, least);
-    // the far side holds only states at least |across| away along joint j
-    if (far < 0 || across * across >= least) return;
+    // the far side holds only states at least |across| away along joint j (a wrapping
+    // angle's far side may be near the other way round: never pruned)
+    if (far < 0 || (!chain_.wraps(j) && across * across >= least)) return;
     node = far;
   }
 }
@@ -79,9 +90,7 @@ std::size_t ArmRRTConnect::nearest(const Tree& tree, const double* q) const {
   }
   const std::size_t count = tree.parents.size();
   for (std::size_t i = 0; i < count; ++i) {
-    const double* s = tree.states.data() + i * n_;
-    double d = 0.0;
-    for (int j = 0; j < n_ && d < least; ++j) d += (s[j] - q[j]) * (s[j] - q[j]);
+    const double d = squared(tree.states.data() + i * n_, q);
     if (d < least) least = d, best = i;
   }
   return best;
@@ -91,14 +100,17 @@ ArmRRTConnect::Grown ArmRRTConnect::grow(Tree& tree, const double* target,
                                          ArmMotionValidator& edges, ArmPlan& plan) {
   const std::size_t near = nearest(tree, target);
   const double* from = tree.states.data() + near * n_;
-  const double d = distance(from, target, n_);
+  const double d = distance(from, target);
   if (d == 0.0) {  // the target is in the tree already
     last_ = near;
     return Grown::kReached;
   }
   const bool reach = d <= range_;
   const double t = reach ? 1.0 : range_ / d;
-  for (int j = 0; j < n_; ++j) step_[j] = reach ? target[j] : from[j] + t * (target[j] - from[j]);
+  if (reach)
+    std::copy_n(target, n_, step_.data());
+  else
+    between(from, target, t, step_.data());
   ++plan.tree_edges;
   if (!edges.check(from, step_.data())) return Grown::kTrapped;
   tree.add(step_.data(), static_cast<int>(near), n_, kd_tree_);
@@ -194,7 +206,7 @@ void ArmRRTConnect::shortcut(std::vector<double>& path, ArmMotionValidator& edge
     if (seconds_since(t0) >= deadline) break;
     lengths.assign(1, 0.0);
     for (std::size_t i = 0; i + 1 < states; ++i)
-      lengths.push_back(lengths.back() + distance(state(path, i), state(path, i + 1), n_));
+      lengths.push_back(lengths.back() + distance(state(path, i), state(path, i + 1)));
     double t[2] = {unit(rng_) * lengths.back(), unit(rng_) * lengths.back()};
     if (t[0] > t[1]) std::swap(t[0], t[1]);
     std::size_t seg[2];
@@ -205,7 +217,7 @@ void ArmRRTConnect::shortcut(std::vector<double>& path, ArmMotionValidator& edge
       const double span = lengths[seg[e] + 1] - lengths[seg[e]];
       const double s = span > 0.0 ? (t[e] - lengths[seg[e]]) / span : 0.0;
       const double* a = state(path, seg[e]);
-      for (int j = 0; j < n_; ++j) at[e * n_ + j] = a[j] + s * (a[n_ + j] - a[j]);
+      between(a, a + n_, s, at.data() + e * n_);
     }
     ++failed;
     if (seg[0] == seg[1]) continue;  // on one edge already

@@ -66,6 +66,10 @@ struct ArmPlan {
 /// point between two states lies on a checked edge, so it is valid, and a shortcut from
 /// it is checked as any edge; the path never gets longer (triangle inequality).
 ///
+/// A wrapping angle (Chain::wraps: a moving base's yaw, a continuous joint) is sampled in
+/// [-pi, pi], measured and stepped the shorter way round (as OMPL's SO2StateSpace), and
+/// every state kept in [-pi, pi); an edge is the validators' (Chain::edge_end).
+///
 /// Contract: start and goal have dof() finite numbers within the limits (else
 /// std::invalid_argument); the trees' states are within the limits. Not thread-safe.
 class ArmRRTConnect {
@@ -102,6 +106,12 @@ class ArmRRTConnect {
   bool certify(std::vector<double>& path, double budget, ArmPlan& plan);
   void shortcut(std::vector<double>& path, ArmMotionValidator& edges, double deadline,
                 ArmPlan& plan);
+  /// Joint-space distance (L2) and its square, a wrapping angle's the shorter turn.
+  double distance(const double* a, const double* b) const;
+  double squared(const double* a, const double* b) const;
+  /// a + s (b - a) along the edge from a to b (a wrapping angle the shorter way round,
+  /// brought into [-pi, pi)), into `out`.
+  void between(const double* a, const double* b, double s, double* out) const;
 
   const Chain& chain_;
   ArmMotionValidator& tree_;

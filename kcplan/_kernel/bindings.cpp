@@ -346,11 +346,20 @@ NB_MODULE(_core, m) {
                     const std::vector<bool>&, const std::vector<int>&, const std::vector<double>&,
                     const std::vector<double>&, const std::vector<int>&,
                     const std::vector<double>&, const std::vector<double>&,
-                    const std::vector<std::vector<double>>&, const std::vector<std::vector<int>>&>(),
+                    const std::vector<std::vector<double>>&, const std::vector<std::vector<int>>&,
+                    const std::vector<bool>&>(),
            "parents"_a, "placements"_a, "axes"_a, "prismatic"_a, "states"_a, "lower"_a,
            "upper"_a, "body_joints"_a, "body_placements"_a, "semi_axes"_a,
            "hull_vertices"_a = std::vector<std::vector<double>>(),
-           "hull_triangles"_a = std::vector<std::vector<int>>())
+           "hull_triangles"_a = std::vector<std::vector<int>>(),
+           "wraps"_a = std::vector<bool>())
+      .def("edge_end", [](const kcplan::Chain& c, const std::vector<double>& q1,
+                          const std::vector<double>& q2) {
+        std::vector<double> out(c.dof());
+        const double* end = c.edge_end(joints_of(c, q1), joints_of(c, q2), out.data());
+        return std::vector<double>(end, end + c.dof());
+      }, "q1"_a, "q2"_a, "where the straight edge from q1 towards q2 ends (a wrapping angle "
+      "the shorter way round; kcplan/_kernel/chain.hpp Chain::edge_end)")
       .def_prop_ro("dof", &kcplan::Chain::dof)
       .def_prop_ro("n_bodies", [](const kcplan::Chain& c) { return c.bodies().size(); })
       .def_prop_ro("n_hulls", [](const kcplan::Chain& c) {

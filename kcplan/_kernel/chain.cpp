@@ -26,7 +26,8 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
              const std::vector<double>& upper, const std::vector<int>& body_joints,
              const std::vector<double>& body_placements, const std::vector<double>& semi_axes,
              const std::vector<std::vector<double>>& hull_vertices,
-             const std::vector<std::vector<int>>& hull_triangles)
+             const std::vector<std::vector<int>>& hull_triangles,
+             const std::vector<bool>& wraps)
     : lower_(lower), upper_(upper) {
   const std::size_t n = parents.size(), dof = lower.size();
   if (placements.size() != 16 * n || axes.size() != 3 * n || prismatic.size() != n ||
@@ -54,6 +55,13 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
     if (joint.state < 0 || joint.state >= static_cast<int>(dof))
       throw std::invalid_argument("chain: a joint's state index is out of range");
     joints_.push_back(joint);
+  }
+  if (!wraps.empty()) {
+    if (wraps.size() != dof) throw std::invalid_argument("chain: expected a wrap flag per joint or none");
+    for (const ChainJoint& joint : joints_)
+      if (joint.prismatic && wraps[joint.state])
+        throw std::invalid_argument("chain: only a revolute joint's angle may wrap");
+    if (std::find(wraps.begin(), wraps.end(), true) != wraps.end()) wraps_ = wraps;
   }
   const std::size_t count = body_joints.size();
   if (body_placements.size() != 16 * count || semi_axes.size() != 3 * count)
@@ -90,7 +98,7 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
 
 Chain Chain::with_bodies(std::vector<ChainBody> bodies) const {
   Chain out;
-  out.joints_ = joints_, out.lower_ = lower_, out.upper_ = upper_;
+  out.joints_ = joints_, out.lower_ = lower_, out.upper_ = upper_, out.wraps_ = wraps_;
   out.bodies_ = std::move(bodies);
   for (const ChainBody& b : out.bodies_)
     if (b.joint < 0 || b.joint > static_cast<int>(joints_.size()) || !(b.a_max > 0.0))
@@ -124,9 +132,27 @@ void Chain::bound_speeds() {
 }
 
 bool Chain::admits(const double* q) const {
-  for (std::size_t j = 0; j < lower_.size(); ++j)
-    if (!(q[j] >= lower_[j] && q[j] <= upper_[j])) return false;  // NaN fails too
+  for (std::size_t j = 0; j < lower_.size(); ++j) {
+    if (q[j] >= lower_[j] && q[j] <= upper_[j]) continue;  // NaN fails
+    if (!(wraps(static_cast<int>(j)) && std::isfinite(q[j]))) return false;
+  }
   return true;
+}
+
+double Chain::canonical(int j, double v) const {
+  if (!wraps(j)) return v;
+  const double turn = 2.0 * M_PI;
+  return v - turn * std::floor((v + M_PI) / turn);
+}
+
+double Chain::difference(int j, double a, double b) const {
+  return wraps(j) ? canonical(j, b - a) : b - a;
+}
+
+const double* Chain::edge_end(const double* q1, const double* q2, double* out) const {
+  if (wraps_.empty()) return q2;
+  for (int j = 0; j < dof(); ++j) out[j] = wraps_[j] ? q1[j] + difference(j, q1[j], q2[j]) : q2[j];
+  return out;
 }
 
 void Chain::joint_frames(const double* q, std::vector<coal::Transform3s>& out) const {

@@ -58,14 +58,18 @@ class Chain {
   /// bodies; `hull_vertices` and `hull_triangles` (one list per body, or none at all)
   /// the hull of each body that is convex rather than its ellipsoid (empty lists for an
   /// ellipsoid; m x 3 vertices in the body's frame, t x 3 indices). A hull must lie in
-  /// its body's ellipsoid (std::invalid_argument otherwise).
+  /// its body's ellipsoid (std::invalid_argument otherwise). `wraps` (dof() flags, or
+  /// none) marks the revolute joints whose angle wraps (a moving base's yaw, a continuous
+  /// joint; kcplan/arm/description.py): admits() takes any finite angle of theirs, and an
+  /// edge turns them the shorter way (edge_end()).
   Chain(const std::vector<int>& parents, const std::vector<double>& placements,
         const std::vector<double>& axes, const std::vector<bool>& prismatic,
         const std::vector<int>& states, const std::vector<double>& lower,
         const std::vector<double>& upper, const std::vector<int>& body_joints,
         const std::vector<double>& body_placements, const std::vector<double>& semi_axes,
         const std::vector<std::vector<double>>& hull_vertices = {},
-        const std::vector<std::vector<int>>& hull_triangles = {});
+        const std::vector<std::vector<int>>& hull_triangles = {},
+        const std::vector<bool>& wraps = {});
 
   int dof() const { return static_cast<int>(lower_.size()); }
   /// Joints of the reduced model, the universe included.
@@ -74,8 +78,23 @@ class Chain {
   const std::vector<double>& lower() const { return lower_; }
   const std::vector<double>& upper() const { return upper_; }
 
-  /// Whether every number of q (dof() of them) is finite and within its limits.
+  /// Whether every number of q (dof() of them) is finite and within its limits (a
+  /// wrapping angle: finite).
   bool admits(const double* q) const;
+  /// Whether any joint's angle wraps.
+  bool wraps() const { return !wraps_.empty(); }
+  /// Whether joint j's (state order) angle wraps.
+  bool wraps(int j) const { return !wraps_.empty() && wraps_[j]; }
+  /// Where the straight edge from q1 towards q2 ends: q2 itself when no angle wraps,
+  /// else `out` (dof() numbers) holding q2 with every wrapping angle at q1's plus the
+  /// shorter turn, in [-pi, pi) (outside [-pi, pi] where the turn crosses it). Every
+  /// state of the edge is q1 + s (end - q1), s in [0, 1] (kcplan/arm/description.py
+  /// unwrapped).
+  const double* edge_end(const double* q1, const double* q2, double* out) const;
+  /// b - a for joint j: the shorter turn in [-pi, pi) for a wrapping angle.
+  double difference(int j, double a, double b) const;
+  /// An angle of joint j brought into [-pi, pi) if it wraps (unchanged otherwise).
+  double canonical(int j, double v) const;
   /// World frames of every joint, the universe first (joint_count() of them).
   void joint_frames(const double* q, std::vector<coal::Transform3s>& out) const;
   /// World frames of every body (bodies().size() of them); `joints` is scratch.
@@ -157,6 +176,7 @@ class Chain {
   std::vector<ChainBody> bodies_;
   std::vector<double> lower_, upper_, rho_;
   std::vector<bool> carries_;
+  std::vector<bool> wraps_;  // dof() flags, or empty: no angle wraps
 };
 
 }  // namespace kcplan

@@ -54,10 +54,20 @@ EXAMPLE_ARMS: dict[str, tuple[str, str | None, tuple[str, ...]]] = {
         tuple(f"{side}_{joint}" for side in ("left", "right")
               for joint in ("s0", "s1", "e0", "e1", "w0", "w1", "w2")),
     ),  # fmt: skip
+    # a base that drives (its SRDF's planar virtual joint, with robot.base), a torso and two
+    # arms; the arm's forearm and wrist roll joints are continuous: angles that wrap
+    "pr2": (
+        "pr2_description/urdf/pr2.urdf",
+        "pr2_description/srdf/pr2.srdf",
+        ("torso_lift_joint",
+         *(f"r_{joint}_joint" for joint in ("shoulder_pan", "shoulder_lift", "upper_arm_roll",
+                                            "elbow_flex", "forearm_roll", "wrist_flex",
+                                            "wrist_roll"))),
+    ),  # fmt: skip
 }
 """Arms of example-robot-data 6.0.0 that kcplan plans: ``NAME: (URDF, SRDF or None, the
 arm's joints in state order)``, paths relative to :func:`example_folder`; Baxter's are
-both arms. Left out: the Kinova (continuous joints, no limits), the Z1 and the SO-100 (a
+both arms, the PR2's its torso and right arm. Left out: the Z1 and the SO-100 (a
 link and a fixed joint of one name, which Pinocchio's ``buildReducedModel`` refuses)."""
 
 

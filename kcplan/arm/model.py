@@ -52,6 +52,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.arm.bounds import speeds
+from kcplan.arm.description import (
+    Description,
+    DescriptionError,
+    PlanarBase,
+    read_description,
+    unwrapped,
+    wrapped,
+)
 from kcplan.arm.hulls import BodyHull, box_hull, cached_hull_pieces, cylinder_hull
 from kcplan.arm.kinematics import JOINT_KINDS, body_frames, joint_axes
 from kcplan.arm.shapes import bvh_mesh
@@ -176,6 +184,12 @@ class ArmModel(RobotModel):
         collision object of :attr:`geometry` and bodies named after it.
     base_geometry : pinocchio.GeometryModel or None
         :attr:`geometry` without the attached objects (None when none is attached).
+    wraps : ndarray of bool, shape (len(joints),) or None
+        Which joints' angles wrap (a moving base's yaw, a continuous joint:
+        :mod:`kcplan.arm.description`); None: none does.
+    description : Description or None
+        The URDF as Pinocchio read it (:func:`kcplan.arm.description.read_description`): every
+        other reader of the robot's tree (the views' visual geometry) reads it alike.
     """
 
     model: object
@@ -192,6 +206,13 @@ class ArmModel(RobotModel):
     package_dirs: tuple[str, ...] = ()
     attached: tuple = ()
     base_geometry: object = None
+    wraps: NDArray[np.bool_] | None = None
+    description: Description | None = None
+
+    @property
+    def base(self) -> PlanarBase | None:
+        """The moving base (:class:`kcplan.arm.description.PlanarBase`), or None."""
+        return None if self.description is None else self.description.base
 
     @property
     def dof(self) -> int:
@@ -228,13 +249,33 @@ class ArmModel(RobotModel):
     def edge_state(
         self, state1: Sequence[float], state2: Sequence[float], s: float
     ) -> NDArray[np.float64]:
-        """``q1 + s (q2 - q1)``: OMPL's interpolation in the joint box."""
+        """``q1 + s (q2 - q1)``: OMPL's interpolation in the joint box, a wrapping angle
+        the shorter way round (:meth:`edge_end`)."""
         q1 = np.asarray(state1, dtype=float)
-        return q1 + s * (np.asarray(state2, dtype=float) - q1)
+        return q1 + s * (self.edge_end(q1, state2) - q1)
+
+    def edge_end(self, state1: Sequence[float], state2: Sequence[float]) -> NDArray[np.float64]:
+        """Where the straight edge from ``state1`` ends: ``state2``, with every wrapping
+        angle at ``state1``'s plus the shorter turn (:func:`kcplan.arm.description.unwrapped`;
+        outside ``[-pi, pi]`` where the turn crosses it), shape ``(dof,)``."""
+        if self.wraps is None:
+            return np.asarray(state2, dtype=float)
+        return unwrapped(state1, state2, self.wraps)
+
+    def continuous(self, states: Sequence[Sequence[float]]) -> NDArray[np.float64]:
+        """A path's states ``(k, dof)`` with every wrapping angle unwrapped along it: each
+        state the previous one's :meth:`edge_end`, so that straight segments between the
+        rows are the path's edges (what a timing law, a verifier or a view of the path
+        interpolates); shape ``(k, dof)``."""
+        out = np.array(states, dtype=float, ndmin=2)
+        if self.wraps is not None:
+            for k in range(1, len(out)):
+                out[k] = unwrapped(out[k - 1], out[k], self.wraps)
+        return out
 
     def body_speeds(self, state1: Sequence[float], state2: Sequence[float]) -> NDArray[np.float64]:
         """Metres per unit ``s`` (:func:`kcplan.arm.bounds.speeds`)."""
-        return speeds(self, state1, state2)
+        return speeds(self, state1, self.edge_end(state1, state2))
 
     def configuration(self, state: Sequence[float]) -> NDArray[np.float64]:
         """The reduced model's configuration vector of a state ``(dof,)`` (joint values in
@@ -250,7 +291,8 @@ class ArmModel(RobotModel):
         self, q: Sequence[float], tolerance: float = LIMIT_TOLERANCE
     ) -> tuple[NDArray[np.float64], list[str], list[str]]:
         """``q`` (shape ``(dof,)``, finite) with every value within ``tolerance`` outside
-        its joint's limits moved onto the limit.
+        its joint's limits moved onto the limit, and every wrapping angle taken into
+        ``[-pi, pi)``.
 
         Returns
         -------
@@ -263,6 +305,8 @@ class ArmModel(RobotModel):
             the digits that show the difference (``3.141592653589793 > 3.14159``).
         """
         q = np.array(q, dtype=float)
+        if self.wraps is not None:  # any angle of a wrapping joint, taken into [-pi, pi)
+            q = np.where(self.wraps, wrapped(q), q)
         clamped, outside = [], []
         for j, (name, lo, hi) in enumerate(zip(self.joints, self.lower, self.upper, strict=True)):
             v = float(q[j])
@@ -277,44 +321,45 @@ class ArmModel(RobotModel):
         return q, clamped, outside
 
     def within_limits(self, q: Sequence[float]) -> bool:
-        """Whether ``q`` (shape ``(dof,)``) is finite and inside the joint limits."""
+        """Whether ``q`` (shape ``(dof,)``) is finite and inside the joint limits (a
+        wrapping angle: any finite angle)."""
         q = np.asarray(q, dtype=float)
-        return bool(
-            q.shape == (self.dof,)
-            and np.isfinite(q).all()
-            and (q >= self.lower).all()
-            and (q <= self.upper).all()
-        )
+        if q.shape != (self.dof,) or not np.isfinite(q).all():
+            return False
+        inside = (q >= self.lower) & (q <= self.upper)
+        return bool((inside | (False if self.wraps is None else self.wraps)).all())
 
 
-def urdf_model(urdf: str | os.PathLike):
+def urdf_model(urdf: str | os.PathLike, base: PlanarBase | None = None):
     """The URDF's whole joint tree, as Pinocchio reads it (``pinocchio.Model``, no joint
-    locked): what :func:`movable_joints` and an SRDF's groups
-    (:meth:`kcplan.arm.srdf.Srdf.group_joints`) are read against.
+    locked; with ``base``, the base's joints above its root, and continuous joints as
+    wrapping revolute ones: :mod:`kcplan.arm.description`): what :func:`movable_joints`
+    and an SRDF's groups (:meth:`kcplan.arm.srdf.Srdf.group_joints`) are read against.
 
     Raises
     ------
     ArmError
-        ``URDF: urdf: expected a readable URDF, got: ...`` for a file Pinocchio cannot read.
+        ``URDF: urdf: expected a readable URDF, got: ...`` for a file Pinocchio cannot
+        read; ``URDF: robot.base: ...`` for a base the URDF cannot take.
     """
-    import pinocchio as pin
-
     try:
-        return pin.buildModelFromUrdf(os.fspath(urdf))
+        return read_description(urdf, base).model()
+    except DescriptionError as err:
+        raise ArmError(str(err)) from None
     except (RuntimeError, ValueError, OSError) as err:
         raise ArmError(f"{urdf}: urdf: expected a readable URDF, got: {err}") from None
 
 
-def movable_joints(urdf: str | os.PathLike) -> list[str]:
-    """Every joint of the URDF that kcplan can move (revolute or prismatic), in the URDF's
-    order: the planning group when none is named.
+def movable_joints(urdf: str | os.PathLike, base: PlanarBase | None = None) -> list[str]:
+    """Every joint of the URDF that kcplan can move (revolute, continuous or prismatic, and
+    the base's), in the URDF's order: the planning group when none is named.
 
     Raises
     ------
     ArmError
         ``URDF: urdf: expected a readable URDF, got: ...`` for a file Pinocchio cannot read.
     """
-    full = urdf_model(urdf)
+    full = urdf_model(urdf, base)
     return [n for n in full.names[1:] if full.joints[full.getJointId(n)].shortname() in JOINT_KINDS]
 
 
@@ -328,6 +373,7 @@ def load_arm(
     progress: Callable[[str], None] | None = None,
     max_offset: float | None = None,
     representation: str | None = None,
+    base: PlanarBase | None = None,
 ) -> ArmModel:
     """Read an arm from its URDF (and SRDF) and represent its links by bodies.
 
@@ -366,6 +412,10 @@ def load_arm(
         Links as their convex hulls, or as ellipsoid covers (module docstring). Default:
         ``"ellipsoids"`` when ``bodies_per_link`` or ``max_offset`` is given, else
         ``"hulls"``.
+    base : PlanarBase, optional
+        A base that drives (:mod:`kcplan.arm.description`): its joints ``NAME/x``,
+        ``NAME/y``, ``NAME/theta`` may be in ``joints``. Continuous joints are revolute
+        joints whose angle wraps, with or without a base.
 
     Raises
     ------
@@ -402,10 +452,11 @@ def load_arm(
         raise ArmError(f"{source}: urdf: expected a URDF file, found none")
     dirs = package_folders(source, package_dirs)
     try:
-        full = pin.buildModelFromUrdf(source)
-        full_geometry = pin.buildGeomFromUrdf(
-            full, source, pin.GeometryType.COLLISION, package_dirs=dirs
-        )
+        description = read_description(source, base)
+        full = description.model()
+        full_geometry = description.geometry(full, pin.GeometryType.COLLISION, dirs)
+    except DescriptionError as err:
+        raise ArmError(str(err)) from None
     except (RuntimeError, ValueError, OSError) as err:
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         missing = re.search(r"Mesh (\S+) could not be found", first)
@@ -491,10 +542,12 @@ def load_arm(
         for frame, semi_axes in _cover(obj, bodies_per_link, max_offset, source, progress):
             bodies.append(ArmBody(link, index, int(obj.parentJoint), placement @ frame, semi_axes))
     self_pairs = self_pairs_of(geometry, bodies)
+    wraps = np.array([name in description.wrapping for name in group], dtype=bool)
     return ArmModel(
         model, geometry, tuple(group), q_index, np.array(lower), np.array(upper), kinds,
         tuple(bodies), self_pairs, source, "" if srdf is None else os.fspath(srdf),
         tuple(os.fspath(d) for d in package_dirs or ()),
+        wraps=wraps if wraps.any() else None, description=description,
     )  # fmt: skip
 
 

@@ -5,6 +5,7 @@ The format (``scenarios/README.md``)::
     name: box_1
     robot: {urdf: panda/panda.urdf, srdf: panda/panda.srdf,   # or example: NAME
             joints: [panda_joint1, ..., panda_joint7],        # or group: panda_arm
+            base: {type: planar, bounds: [[-2, 2], [-2, 2]]}, # a base that drives
             fixed: {NAME: VALUE},
             package_dirs: [DIR], representation: hulls, bodies_per_link: K,
             max_offset: E, inflation: 0.0}
@@ -29,6 +30,14 @@ order; every other joint is fixed, at ``fixed`` or 0 (:func:`kcplan.arm.load_arm
 order, :mod:`kcplan.arm.srdf`), and a start or goal may be one of the SRDF's named
 states (``state: NAME``: the group's ``group_state``, or with ``joints`` a state of any
 group that sets every joint of the planning group).
+``base: {type: planar, bounds: [[xmin, xmax], [ymin, ymax]], name: N, velocity: [0.5,
+1.0]}`` makes the robot
+drive (:mod:`kcplan.arm.description`): its joints ``N/x``, ``N/y`` (metres) and
+``N/theta`` (radians, an angle that wraps: an edge turns it the shorter way round) stand
+before the URDF's root link, named after the SRDF's planar virtual joint (else ``base``);
+they belong to the planning group when ``joints`` lists them, when ``group`` includes the
+virtual joint, or, for an example robot without either, before its arm's joints;
+``velocity`` (m/s along x and y, rad/s of yaw) times a trajectory.
 ``representation`` is ``hulls`` (each link its own convex hull, the default) or
 ``ellipsoids`` (covers; the default when ``bodies_per_link`` or ``max_offset`` is given).
 ``max_offset`` (metres) cuts each link's cover until it sticks out of the link's mesh by
@@ -55,6 +64,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from kcplan.arm.attach import Attached, attach
+from kcplan.arm.description import BASE_TYPES, DEFAULT_BASE_VELOCITY, PlanarBase
 from kcplan.arm.examples import example_robot
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import (
@@ -165,7 +175,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         top["robot"], "robot", (),
         ("urdf", "example", "joints", "group", "srdf", "fixed", "package_dirs",
          "representation", "bodies_per_link", "max_offset", "inflation", "padding",
-         "link_padding"),
+         "link_padding", "base"),
     )  # fmt: skip
     if ("urdf" in spec) == ("example" in spec):
         r.fail("robot", "a urdf (a file) or an example (a robot of example-robot-data)",
@@ -177,9 +187,8 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             raise ScenarioError(f"{source}: {err}") from None
         if "srdf" in spec:
             srdf = directory / r.text(spec["srdf"], "robot.srdf")
-        if "group" not in spec:
-            spec.setdefault("joints", list(default_joints))
     else:
+        default_joints = ()
         urdf = directory / r.text(spec["urdf"], "robot.urdf")
         srdf = directory / r.text(spec["srdf"], "robot.srdf") if "srdf" in spec else None
         if "joints" not in spec and "group" not in spec:
@@ -190,6 +199,10 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
             r.fail(f"robot.{key}", f"an existing {key.upper()} file (relative to the scenario)",
                    None, f"{spec.get(key)!r}, which does not exist at {path}")  # fmt: skip
     semantic = _Semantic(r, urdf, srdf)
+    base = _base(r, spec["base"], semantic) if "base" in spec else None
+    semantic.base = base
+    if default_joints and "group" not in spec and "joints" not in spec:
+        spec["joints"] = [*(base.joints if base else ()), *default_joints]  # an example's arm
     if "group" in spec:  # the spec keeps the group (written back as it was read)
         if "joints" in spec:
             r.fail("robot.group", "a group or joints, not both", spec["group"])
@@ -231,6 +244,7 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
         arm = load_arm(
             urdf, joints, srdf=srdf, fixed=fixed, bodies_per_link=bodies, progress=_fit_notice,
             max_offset=max_offset, representation=representation, package_dirs=package_dirs,
+            base=base,
         )  # fmt: skip
     except ArmError as err:
         raise ScenarioError(f"{source}: robot: {err}") from None
@@ -268,6 +282,14 @@ class _Semantic:
 
     def __init__(self, r: FieldReader, urdf: Path, srdf: Path | None) -> None:
         self._r, self._urdf, self._srdf, self._read = r, urdf, srdf, None
+        self.base: PlanarBase | None = None  # the model a group is read against has it
+
+    def planar_joint(self) -> str | None:
+        """The name of the SRDF's planar virtual joint, if there is an SRDF with one."""
+        if self._srdf is None:
+            return None
+        planar = [v.name for v in self._srdf_of("robot.srdf").virtual_joints if v.kind == "planar"]
+        return planar[0] if planar else None
 
     def _srdf_of(self, field: str) -> Srdf:
         if self._srdf is None:
@@ -282,7 +304,7 @@ class _Semantic:
     def joints(self, group: str) -> tuple[str, ...]:
         srdf = self._srdf_of("robot.group")
         try:
-            return srdf.group_joints(group, urdf_model(self._urdf))
+            return srdf.group_joints(group, urdf_model(self._urdf, self.base))
         except ArmError as err:  # the group, or a URDF Pinocchio cannot read
             raise ScenarioError(f"{self._r.source}: robot: {err}") from None
 
@@ -294,6 +316,33 @@ class _Semantic:
             return srdf.state(name, joints, group)
         except ArmError as err:
             raise ScenarioError(f"{self._r.source}: {where}: {err}") from None
+
+
+def _base(r: FieldReader, value: Any, semantic: _Semantic | None) -> PlanarBase:
+    """``robot.base``: ``{type: planar, bounds: [[xmin, xmax], [ymin, ymax]], name: N,
+    velocity: [m/s, rad/s]}`` (:class:`kcplan.arm.description.PlanarBase`);
+    the name defaults to the SRDF's planar virtual joint's (else ``base``), so the base's
+    joints are named as MoveIt names its variables (``N/x``, ``N/y``, ``N/theta``)."""
+    spec = r.mapping(value, "robot.base", ("type", "bounds"), ("name", "velocity"))
+    if spec["type"] not in BASE_TYPES:
+        r.fail("robot.base.type", f"one of {', '.join(BASE_TYPES)}", spec["type"])
+    bounds = spec["bounds"]
+    if not (isinstance(bounds, list) and len(bounds) == 2):
+        r.fail("robot.base.bounds", "[[xmin, xmax], [ymin, ymax]] (metres)", bounds)
+    pairs = []
+    for axis, pair in zip("xy", bounds, strict=True):
+        low, high = r.vector(pair, f"robot.base.bounds.{axis}", 2)
+        if not low < high:
+            r.fail(f"robot.base.bounds.{axis}", "[min, max] with min < max (metres)", pair)
+        pairs.append((float(low), float(high)))
+    velocity = DEFAULT_BASE_VELOCITY
+    if "velocity" in spec:
+        velocity = tuple(float(v) for v in r.vector(spec["velocity"], "robot.base.velocity", 2,
+                                                    positive=True))  # fmt: skip
+    name = spec.get("name")
+    if name is None:
+        name = (semantic.planar_joint() if semantic is not None else None) or "base"
+    return PlanarBase(r.text(name, "robot.base.name"), (pairs[0], pairs[1]), velocity)
 
 
 def _link_padding(r: FieldReader, spec: dict, arm: ArmModel) -> dict[str, float]:

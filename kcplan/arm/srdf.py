@@ -17,8 +17,10 @@ joint tree (Pinocchio's model), as MoveIt's ``RobotModel`` builds a ``JointModel
 
 A group's joints are its revolute and prismatic joints in the URDF's depth-first order
 (Pinocchio's joint order, MoveIt's variable order). A group that names a joint kcplan
-cannot plan (continuous, floating, planar; a virtual joint: a moving base) is refused
-with a line naming it.
+cannot plan (floating, planar) is refused with a line naming it. A continuous joint is
+a revolute one whose angle wraps, and the planar virtual joint stands for the moving
+base's three joints when the model was read with that base
+(:mod:`kcplan.arm.description`).
 """
 
 from __future__ import annotations
@@ -73,7 +75,8 @@ class Srdf:
         ----------
         name : str
         model : pinocchio.Model
-            The URDF's whole model (``pinocchio.buildModelFromUrdf``).
+            The URDF's whole model (:func:`kcplan.arm.model.urdf_model`, with the moving
+            base when the group names the virtual joint).
 
         Raises
         ------
@@ -138,10 +141,9 @@ class Srdf:
             elif kind == "joint":
                 joint = attrs.get("name", "")
                 if joint in virtual:
-                    raise ArmError(f"{where}: {joint!r} is a virtual joint (a moving base); "
-                                   "expected the robot's own joints: kcplan plans a fixed "
-                                   "base")  # fmt: skip
-                ids |= _movable(model, joint, where)
+                    ids |= _base_joints(model, joint, where)
+                else:
+                    ids |= _movable(model, joint, where)
             elif kind == "link":
                 ids |= _parent_joint(model, attrs.get("name", ""), where)
             else:  # chain
@@ -229,6 +231,17 @@ def _movable(model, joint: str, where: str) -> set[int]:
     if model.existFrame(joint) and _is_fixed_joint(model, model.getFrameId(joint)):
         return set()
     raise ArmError(f"{where}: {joint!r} is not a joint of the URDF")
+
+
+def _base_joints(model, joint: str, where: str) -> set[int]:
+    """The joints of the moving base named after virtual joint ``joint``
+    (:class:`kcplan.arm.description.PlanarBase`: ``JOINT/x``, ``JOINT/y``,
+    ``JOINT/theta``), which ``model`` has when it was read with that base."""
+    names = [f"{joint}/{axis}" for axis in ("x", "y", "theta")]
+    if not all(model.existJointName(name) for name in names):
+        raise ArmError(f"{where}: {joint!r} is a virtual joint (a moving base); expected "
+                       "robot.base (type: planar, bounds) to plan it")  # fmt: skip
+    return {int(model.getJointId(name)) for name in names}
 
 
 def _link_frame(model, link: str, where: str):

@@ -302,7 +302,7 @@ class ArmMeshChecker:
         """Check the path through ``states`` (joint vectors, :attr:`ArmModel.joints`
         order) without gaps; ``max_queries`` distance queries per segment at most
         (RuntimeError beyond)."""
-        states = [np.asarray(q, dtype=float) for q in states]
+        states = list(self.arm.continuous(states))  # a wrapping angle the shorter way
         pieces = [
             (lambda s, q1=q1, dq=q2 - q1: q1 + s * dq, np.abs(q2 - q1))
             for q1, q2 in zip(states[:-1], states[1:], strict=True)

@@ -354,6 +354,7 @@ class ArmEdgeCertifier:
         c = self.counters
         c["edges"] += 1
         q1, q2 = self._joints(state1), self._joints(state2)
+        q2 = self.arm.edge_end(q1, q2)  # a wrapping angle turns the shorter way
         if not (self._admits(q1) and self._admits(q2)):
             return self._reject("rejected_end_state")
         if not self.state_valid(q2):
@@ -394,6 +395,7 @@ class ArmEdgeCertifier:
             raise ValueError(f"step: expected a joint-space distance > 0, got {step}")
         self.counters["screened_edges"] += 1
         q1, q2 = self._joints(state1), self._joints(state2)
+        q2 = self.arm.edge_end(q1, q2)
         if not (self._admits(q1) and self._admits(q2) and self.state_valid(q2)):
             return False
         return self._probe(q1, q2, 0.0, 1.0, _length(q2 - q1), step)

@@ -198,7 +198,7 @@ class ArmSetup(ProblemSetup):
         )  # fmt: skip
         self.world.reset_counters()
         self.backend, self.joints = spec.backend, arm.joints
-        self._open(joint_space(arm.lower, arm.upper))
+        self._open(joint_space(arm.lower, arm.upper, arm.wraps))
         n = arm.dof
         if spec.kc:
             certificates = spec.arm_certificates or ARM_CERTIFICATES_OF.get(
@@ -218,7 +218,7 @@ class ArmSetup(ProblemSetup):
             self.state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
         elif spec.backend == "kernel":
             kernel, admits = self.world.kernel, self.world.kernel.chain.admits
-            joints = joint_reader(n)  # as the kc validator reads them: a fair comparison
+            joints = joint_reader(n, arm.wraps)  # as the kc validator reads them: a fair comparison
 
             def state_valid(state) -> bool:
                 q = joints(state)
@@ -229,7 +229,7 @@ class ArmSetup(ProblemSetup):
             world = self.world
 
             def state_valid(state) -> bool:
-                q = joint_state(state, n)
+                q = joint_state(state, n, arm.wraps)
                 return arm.within_limits(q) and not world.in_collision(q)
 
             self.state_valid = state_valid
@@ -238,16 +238,16 @@ class ArmSetup(ProblemSetup):
             self.si.setStateValidityCheckingResolution(step)
 
     def read(self, state) -> NDArray[np.float64]:
-        return joint_state(state, self.arm.dof)
+        return joint_state(state, self.arm.dof, self.arm.wraps)
 
     def write(self, state, values) -> None:
-        set_joint_state(state, values)
+        set_joint_state(state, values, self.arm.wraps)
 
     def timed(self, states: list, velocity_limits=None, acceleration_limits=None):
         from kcplan.trajectory import certified as trajectory
 
-        return trajectory.certified_trajectory(
-            self.world, states, velocity_limits, acceleration_limits
+        return trajectory.certified_trajectory(  # a wrapping angle unwrapped along the path
+            self.world, self.arm.continuous(states), velocity_limits, acceleration_limits
         )
 
 

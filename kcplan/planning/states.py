@@ -1,4 +1,6 @@
-"""Conversions between OMPL SE(2)/SE(3) states and kcplan's flat pose vectors.
+"""Conversions between OMPL states and kcplan's flat vectors: SE(2)/SE(3) poses of rigid
+robots, and arms' joint vectors (a ``RealVectorStateSpace``, or a compound one with
+``SO2StateSpace`` parts for angles that wrap).
 
 Only getters and setters are used: ``copyFromReals`` segfaults and ``copyToReals``
 silently does nothing on the OMPL 2.0 wheel (ompl-python-notes 1).
@@ -12,6 +14,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 from ompl import base as ob
+
+from kcplan.arm.description import wrapped
 
 __all__ = [
     "joint_reader",
@@ -45,10 +49,42 @@ def state_pose(state, n: int) -> np.ndarray:
     return np.array([state.getX(), state.getY(), state.getZ(), r.x, r.y, r.z, r.w])
 
 
-def joint_space(lower: ArrayLike, upper: ArrayLike) -> ob.RealVectorStateSpace:
-    """The joint box of an arm's planning group: a ``RealVectorStateSpace`` with bounds
-    ``lower``, ``upper`` (shape ``(dof,)``, the joint limits)."""
+def _runs(dof: int, wraps: ArrayLike | None) -> list[tuple[bool, range]]:
+    """The joints in state order as runs: ``(True, range(j, j + 1))`` for a wrapping
+    angle (an ``SO2StateSpace``), ``(False, range(a, b))`` for joints that do not wrap
+    (one ``RealVectorStateSpace``)."""
+    flags = np.zeros(dof, dtype=bool) if wraps is None else np.asarray(wraps, dtype=bool)
+    runs: list[tuple[bool, range]] = []
+    for j, wrap in enumerate(flags):
+        if wrap or not runs or runs[-1][0]:
+            runs.append((bool(wrap), range(j, j + 1)))
+        else:
+            runs[-1] = (False, range(runs[-1][1].start, j + 1))
+    return runs
+
+
+def joint_space(
+    lower: ArrayLike, upper: ArrayLike, wraps: ArrayLike | None = None
+) -> ob.StateSpace:
+    """The joint space of an arm's planning group: a ``RealVectorStateSpace`` with bounds
+    ``lower``, ``upper`` (shape ``(dof,)``, the joint limits); where ``wraps`` (shape
+    ``(dof,)``) marks angles that wrap (a moving base's yaw, a continuous joint:
+    :mod:`kcplan.arm.description`), a ``CompoundStateSpace`` of ``SO2StateSpace`` for each
+    of them and ``RealVectorStateSpace`` for the runs of other joints between them, in
+    state order, every weight 1. OMPL then interpolates a wrapping angle the shorter way
+    round, and measures distance as the sum of the parts' (L2 within a run)."""
     lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    runs = _runs(len(lower), wraps)
+    if len(runs) == 1 and not runs[0][0]:
+        return _box(lower, upper)
+    space = ob.CompoundStateSpace()
+    for wrap, joints in runs:
+        part = ob.SO2StateSpace() if wrap else _box(lower[joints], upper[joints])
+        space.addSubspace(part, 1.0)
+    return space
+
+
+def _box(lower: np.ndarray, upper: np.ndarray) -> ob.RealVectorStateSpace:
     space = ob.RealVectorStateSpace(len(lower))
     bounds = ob.RealVectorBounds(len(lower))
     for j, (low, high) in enumerate(zip(lower, upper, strict=True)):
@@ -58,24 +94,54 @@ def joint_space(lower: ArrayLike, upper: ArrayLike) -> ob.RealVectorStateSpace:
     return space
 
 
-def joint_state(state, dof: int) -> np.ndarray:
-    """Joint vector of a ``RealVectorStateSpace`` state, shape ``(dof,)``."""
-    return np.array(joint_reader(dof)(state))
+def joint_state(state, dof: int, wraps: ArrayLike | None = None) -> np.ndarray:
+    """Joint vector of a state of :func:`joint_space`, shape ``(dof,)``."""
+    return np.array(joint_reader(dof, wraps)(state))
 
 
-def joint_reader(dof: int) -> Callable[[object], tuple[float, ...]]:
-    """A function reading the ``dof`` joint values of a ``RealVectorStateSpace`` state as a
-    tuple: ``operator.itemgetter``, whose ``dof`` reads run in C (0.5 µs for 7 joints
-    against 1.5 µs for a list comprehension, on every state an OMPL callback sees)."""
+def joint_reader(
+    dof: int, wraps: ArrayLike | None = None
+) -> Callable[[object], tuple[float, ...]]:
+    """A function reading the ``dof`` joint values of a state of :func:`joint_space` as a
+    tuple. For a ``RealVectorStateSpace``: ``operator.itemgetter``, whose ``dof`` reads
+    run in C (0.5 µs for 7 joints against 1.5 µs for a list comprehension, on every state
+    an OMPL callback sees); for a compound space, the parts' values in turn."""
+    runs = _runs(dof, wraps)
+    if len(runs) > 1 or runs[0][0]:
+        parts = [(k, wrap, len(joints)) for k, (wrap, joints) in enumerate(runs)]
+
+        def read(state) -> tuple[float, ...]:
+            out: list[float] = []
+            for k, wrap, count in parts:
+                part = state[k]
+                if wrap:
+                    out.append(part.value)
+                else:
+                    out.extend(part[i] for i in range(count))
+            return tuple(out)
+
+        return read
     if dof == 1:  # itemgetter of one index returns the value, not a tuple
         return lambda state: (state[0],)
     return operator.itemgetter(*range(dof))
 
 
-def set_joint_state(state, q: ArrayLike) -> None:
-    """Write a joint vector into a ``RealVectorStateSpace`` state."""
-    for j, value in enumerate(np.asarray(q, dtype=float)):
-        state[j] = float(value)
+def set_joint_state(state, q: ArrayLike, wraps: ArrayLike | None = None) -> None:
+    """Write a joint vector into a state of :func:`joint_space` (a wrapping angle brought
+    into ``[-pi, pi)``)."""
+    q = np.asarray(q, dtype=float)
+    runs = _runs(len(q), wraps)
+    if len(runs) == 1 and not runs[0][0]:
+        for j, value in enumerate(q):
+            state[j] = float(value)
+        return
+    for k, (wrap, joints) in enumerate(runs):
+        part = state[k]
+        if wrap:
+            part.value = float(wrapped(q[joints.start]))
+        else:
+            for i, j in enumerate(joints):
+                part[i] = float(q[j])
 
 
 def set_state(state, pose: ArrayLike, n: int) -> None:

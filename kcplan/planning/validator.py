@@ -36,6 +36,7 @@ Contract (OMPL's, as far as the Python binding allows):
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import partial
 
 from numpy.typing import ArrayLike
 from ompl import base as ob
@@ -102,12 +103,13 @@ class KCMotionValidator(ob.MotionValidator):
         motion for a rigid robot), which proves nothing; a lazy planner sets it while
         its trees grow and certifies the path it returns (:mod:`kcplan.planning.lazy`)."""
         arm = isinstance(world, ArmWorld)
-        self._read = joint_state if arm else state_pose
+        wraps = world.arm.wraps if arm else None
+        self._read = partial(joint_state, wraps=wraps) if arm else state_pose
         if self.backend != "kernel":
             return
         # the hot paths: one call into the kernel with the state's floats, nothing else
         if arm:
-            self._joints = joint_reader(self.n)
+            self._joints = joint_reader(self.n, wraps)
             self.state_valid, self.checkMotion = self._valid_kernel_arm, self._check_kernel_arm
         elif self.n == 2:
             self.state_valid = self._valid_kernel_se2

@@ -148,7 +148,8 @@ def animate_arm(
     links, _ = arm_meshes(arm, meshes, max_faces)
     ghosts, _ = arm_meshes(arm, "collision", max(max_faces // 4, 50))  # closed, coarse
     cover = cover_meshes(arm, 1) if show_cover else []
-    dense = np.asarray(states, dtype=float) if timed else joint_path(states, max(frames - 1, 1))
+    dense = (np.asarray(states, dtype=float) if timed
+             else joint_path(arm.continuous(states), max(frames - 1, 1)))  # fmt: skip
     along = joint_frames_along(arm, dense)
     ends = joint_frames_along(arm, [scenario.start, scenario.goal])
     ghosts = [m for m in ghosts if m.joint != 0]  # the fixed links are drawn moving

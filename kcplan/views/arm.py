@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from kcplan.arm.description import read_description
 from kcplan.arm.model import package_folders
 from kcplan.arm.shapes import bvh_mesh
 
@@ -227,10 +228,11 @@ def _visual_geometry(arm):
     import pinocchio as pin
 
     urdf = arm.urdf
-    full = pin.buildModelFromUrdf(urdf)
+    description = arm.description or read_description(urdf)  # the tree the arm was read as
+    full = description.model()
     try:
         folders = package_folders(urdf, arm.package_dirs)
-        visual = pin.buildGeomFromUrdf(full, urdf, pin.GeometryType.VISUAL, package_dirs=folders)
+        visual = description.geometry(full, pin.GeometryType.VISUAL, folders)
     except (RuntimeError, ValueError, OSError) as err:
         lines = str(err).strip().splitlines()
         return None, lines[0] if lines else type(err).__name__

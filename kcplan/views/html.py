@@ -474,7 +474,8 @@ def arm_view_data(
 
     arm = scenario.arm
     if states is not None and len(states):
-        path = np.asarray(states, dtype=float) if timed else joint_path(states, max(frames - 1, 1))
+        path = (np.asarray(states, dtype=float) if timed
+                else joint_path(arm.continuous(states), max(frames - 1, 1)))  # fmt: skip
         last = len(path) - 1
         labels = [f"frame {k} of {last}" + (" (start)" if k == 0 else " (goal)" if k == last
                   else "") for k in range(len(path))]  # fmt: skip

@@ -600,7 +600,7 @@ def plot_arm(
     ]
     tip_path = None
     if states is not None and len(states) > 1:
-        dense = joint_path(states, 200)
+        dense = joint_path(arm.continuous(states), 200)
         along = joint_frames_along(arm, dense)
         tip_path = along[:, tip_joint(arm), :3, 3]
         lengths = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(dense, axis=0), axis=1))]
