@@ -35,7 +35,7 @@ Chain::Chain(const std::vector<int>& parents, const std::vector<double>& placeme
     throw std::invalid_argument(
         "chain: expected 16 placement, 3 axis numbers, a kind and a state index per joint");
   if (dof == 0 || dof > static_cast<std::size_t>(kMaxJoints) || upper.size() != dof)
-    throw std::invalid_argument("chain: expected 1 to 16 joints with a lower and upper limit each");
+    throw std::invalid_argument("chain: expected 1 to 24 joints with a lower and upper limit each");
   for (std::size_t j = 0; j < dof; ++j)
     if (!(lower[j] <= upper[j]) || !std::isfinite(lower[j]) || !std::isfinite(upper[j]))
       throw std::invalid_argument("chain: expected finite limits with lower <= upper");

@@ -49,7 +49,7 @@ struct ChainBody {
 /// certifiers.
 class Chain {
  public:
-  static constexpr int kMaxJoints = 16;
+  static constexpr int kMaxJoints = 24;  // a moving base and two arms: TIAGo dual has 20
 
   /// `parents`, `placements` (16 numbers per joint, a row-major homogeneous matrix),
   /// `axes` (3 per joint), `prismatic` and `states` describe joints 1..n of the reduced

@@ -259,18 +259,42 @@ class ArmMeshChecker:
         limits, seeded) at which the links named ``pair`` touch on their own meshes: 1.0
         for a pair in contact everywhere (two halves of a gripper whose SRDF forgot them),
         which no planner can separate. 0.0 for a pair this checker does not check."""
-        names = set(pair)
-        items = [len(self._links) + m for m, (a, b) in enumerate(self._pairs)
-                 if {self._names[a], self._names[b]} == names]  # fmt: skip
-        if not items:
-            return 0.0
+        return self._contacts([pair], samples, seed, stop=False)[0] / samples
+
+    def touching_everywhere(
+        self, pairs: Sequence[tuple[str, str]], samples: int = 32, seed: int = 0
+    ) -> list[tuple[str, str]]:
+        """The pairs of ``pairs`` whose :meth:`contact_share` is 1.0, at the cost of one
+        placement per sample for all of them (a pair is dropped at its first sample
+        apart): what ``kcplan robot info`` asks of thousands of pairs."""
+        counts = self._contacts(pairs, samples, seed, stop=True)
+        return [pair for pair, count in zip(pairs, counts, strict=True) if count == samples]
+
+    def _contacts(self, pairs, samples: int, seed: int, stop: bool) -> list[int]:
+        """At how many of ``samples`` seeded random configurations each pair of links
+        touches (``stop``: a pair is no longer checked after a sample apart)."""
+        index: dict[frozenset, list[int]] = {}
+        for m, (a, b) in enumerate(self._pairs):
+            index.setdefault(frozenset((self._names[a], self._names[b])), []).append(
+                len(self._links) + m
+            )
+        items = [index.get(frozenset(pair), []) for pair in pairs]
+        counts = [0] * len(pairs)
+        live = [k for k, found in enumerate(items) if found]
         rng = np.random.default_rng(seed)
-        arm = self.arm
-        touching = 0
         for _ in range(samples):
-            self._place(rng.uniform(arm.lower, arm.upper))
-            touching += any(self._distance(i) <= self.tolerance for i in items)
-        return touching / samples
+            if not live:
+                break
+            self._place(rng.uniform(self.arm.lower, self.arm.upper))
+            kept = []
+            for k in live:
+                if any(self._distance(i) <= self.tolerance for i in items[k]):
+                    counts[k] += 1
+                    kept.append(k)
+                elif not stop:
+                    kept.append(k)
+            live = kept
+        return counts
 
     def _what(self, item: int) -> str:
         """The names of item ``item``'s two sides (:attr:`ArmPathCheck.what`)."""

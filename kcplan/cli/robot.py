@@ -126,22 +126,32 @@ def run_info(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         srdf = None if args.srdf is None else read_srdf(args.srdf)
-        full = None if srdf is None else urdf_model(args.urdf)  # the groups' joint tree
+        base = None if args.base is None else _base(args.base, srdf)
+        full = None if srdf is None else urdf_model(args.urdf, base)  # the groups' joint tree
         if args.group is not None:
             joints = srdf.group_joints(args.group, full)
-        else:
-            joints = args.joints or movable_joints(args.urdf)  # every movable joint, in order
-        arm = load_arm(args.urdf, joints, srdf=args.srdf, package_dirs=args.package_dir)
+        else:  # every movable joint, in order (the base's first)
+            joints = args.joints or movable_joints(args.urdf, base)
+        arm = load_arm(args.urdf, joints, srdf=args.srdf, package_dirs=args.package_dir,
+                       base=base)  # fmt: skip
     except ArmError as err:
         raise InputError(str(err)) from None
     took = time.perf_counter() - t0
     print(f"{args.urdf}: {arm.dof} joints in the group, {len(arm.bodies)} bodies "
           f"(links as their convex hulls), read in {took:.1f} s")  # fmt: skip
     if srdf is not None:
-        _print_srdf(srdf, full)
+        _print_srdf(srdf, full, base)
+    if base is not None:
+        (xmin, xmax), (ymin, ymax) = base.bounds
+        print(f"base {base.name}: planar, x in [{xmin:g}, {xmax:g}] m, y in [{ymin:g}, "
+              f"{ymax:g}] m, at most {base.velocity[0]:g} m/s and {base.velocity[1]:g} rad/s; "
+              f"joints {', '.join(base.joints)} (the yaw wraps)")  # fmt: skip
     print("joints (state order): name, kind, limits")
-    for name, kind, lo, hi in zip(arm.joints, arm.kinds, arm.lower, arm.upper, strict=True):
-        print(f"  {name}: {kind} [{float(lo)!r}, {float(hi)!r}]")
+    wraps = [False] * arm.dof if arm.wraps is None else arm.wraps.tolist()
+    for name, kind, lo, hi, wrap in zip(arm.joints, arm.kinds, arm.lower, arm.upper, wraps,
+                                        strict=True):  # fmt: skip
+        turn = " (an angle that wraps: any angle, edges the shorter way)" if wrap else ""
+        print(f"  {name}: {kind} [{float(lo)!r}, {float(hi)!r}]{turn}")
     print("bodies: link, shape, bounding radius (m)")
     for body in arm.bodies:
         shape = "sphere" if body.hull is None else f"hull of {len(body.hull.vertices)} vertices"
@@ -161,9 +171,8 @@ def run_info(args: argparse.Namespace) -> int:
     from kcplan.arm.verify import ArmMeshChecker
 
     checker = ArmMeshChecker(arm, [])
-    always = [p.links for p in proofs
-              if p.verdict == "touches" and checker.contact_share(p.links) == 1.0]  # fmt: skip
-    always = list(dict.fromkeys(always))  # a pair of links with several geometries: once
+    touching = list(dict.fromkeys(p.links for p in proofs if p.verdict == "touches"))
+    always = checker.touching_everywhere(touching)  # a pair of several geometries: once
     if always:  # no plan can separate them: the SRDF misses them
         pairs = ", ".join(f"[{a}, {b}]" for a, b in always)
         print(f"in contact at every configuration tried (32 random ones within the limits): "
@@ -171,7 +180,19 @@ def run_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_srdf(srdf, model) -> None:
+def _base(bounds: list[float], srdf):
+    """``--base XMIN XMAX YMIN YMAX``: the planar base, named after the SRDF's planar
+    virtual joint (else ``base``)."""
+    from kcplan.arm.description import PlanarBase
+
+    xmin, xmax, ymin, ymax = bounds
+    if not (xmin < xmax and ymin < ymax) or not all(map(math.isfinite, bounds)):
+        raise InputError(f"--base: expected XMIN < XMAX and YMIN < YMAX (metres), got {bounds}")
+    planar = [] if srdf is None else [v.name for v in srdf.virtual_joints if v.kind == "planar"]
+    return PlanarBase(planar[0] if planar else "base", ((xmin, xmax), (ymin, ymax)))
+
+
+def _print_srdf(srdf, model, base=None) -> None:
     """The SRDF's planning groups (their joints, or why kcplan cannot plan one), named
     states and virtual joints, for ``kcplan robot info``."""
     from kcplan.arm import ArmError
@@ -189,7 +210,9 @@ def _print_srdf(srdf, model) -> None:
     for v in srdf.virtual_joints:
         print(
             f"virtual joint {v.name}: {v.kind}, {v.parent_frame} to {v.child_link}"
-            + ("" if v.kind == "fixed" else " (kcplan plans the base fixed)")
+            + ("" if v.kind == "fixed" else " (planned: its joints "
+               f"{', '.join(base.joints)})" if base is not None and base.name == v.name
+               else " (kcplan plans the base fixed; --base, a scenario's robot.base, moves it)")
         )
 
 
@@ -262,4 +285,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     chosen.add_argument("--group", metavar="NAME", help="the planning group: a group of --srdf")
     info.add_argument("--package-dir", action="append", metavar="DIR",
                       help="a folder of packages of package:// mesh URIs (repeatable)")  # fmt: skip
+    info.add_argument("--base", nargs=4, type=float, metavar=("XMIN", "XMAX", "YMIN", "YMAX"),
+                      help="a planar base that drives within these bounds (metres), named "
+                      "after the SRDF's planar virtual joint (else base): its joints NAME/x, "
+                      "NAME/y, NAME/theta join the group")  # fmt: skip
     info.set_defaults(handler=run_info)
