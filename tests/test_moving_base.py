@@ -171,8 +171,8 @@ def test_the_chain_bounds_every_point_of_a_driving_robot(pr2):
                 if body.hull is None:
                     continue
                 v = body.hull.vertices
-                moved = np.linalg.norm((v @ b[k][:3, :3].T + b[k][:3, 3])
-                                       - (v @ a[k][:3, :3].T + a[k][:3, 3]), axis=1).max()  # fmt: skip
+                there = v @ b[k][:3, :3].T + b[k][:3, 3]
+                moved = np.linalg.norm(there - (v @ a[k][:3, :3].T + a[k][:3, 3]), axis=1).max()
                 assert moved <= h * speeds[k] * (1 + 1e-9) + 1e-12
 
 
@@ -278,3 +278,85 @@ def test_the_compound_space_reads_and_writes_what_the_kernel_checks(pr2):
     expected = q.copy()
     expected[2] = 3.5 - 2 * math.pi
     np.testing.assert_allclose(read, expected, atol=1e-12)
+
+
+@needs_examples
+def test_an_mbm_request_that_moves_the_base_imports_and_plans(tmp_path, capsys):
+    """MoveIt's names (issue 57 item 1): the start's base is the multi-DOF joint state's
+    transform, the goal names ``world_joint/x``, ``/y``, ``/theta``, and the base's bounds
+    are the request's workspace."""
+    import yaml
+
+    from kcplan.cli import main
+
+    folder = example_folder() / "pr2_description"
+    scene = {"world": {"collision_objects": [{
+        "id": "wall", "primitives": [{"type": "box", "dimensions": [0.1, 1.0, 2.0]}],
+        "primitive_poses": [{"position": [0.0, 1.2, 1.0], "orientation": [0, 0, 0, 1]}],
+    }]}}  # fmt: skip
+    half = math.sin(1.5)  # a start turned 3 rad about z
+    request = {
+        "workspace_parameters": {"min_corner": [-2, -1.5, -1], "max_corner": [2, 1.5, 2]},
+        "start_state": {
+            "joint_state": {"name": ["torso_lift_joint"], "position": [0.1]},
+            "multi_dof_joint_state": {
+                "joint_names": ["world_joint"],
+                "transforms": [{"translation": [-1.0, 0.2, 0.0],
+                                "rotation": [0.0, 0.0, half, math.cos(1.5)]}],  # fmt: skip
+            },
+        },
+        "goal_constraints": [{"joint_constraints": [
+            {"joint_name": name, "position": value}
+            for name, value in (("world_joint/x", 1.0), ("world_joint/y", -0.2),
+                                ("world_joint/theta", -3.0), ("torso_lift_joint", 0.2))
+        ]}],
+    }  # fmt: skip
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene))
+    (tmp_path / "request.yaml").write_text(yaml.safe_dump(request))
+    out = tmp_path / "pr2.yaml"
+    argv = ["import", "mbm", str(tmp_path / "scene.yaml"), str(tmp_path / "request.yaml"),
+            "--urdf", str(folder / "urdf/pr2.urdf"), "--srdf", str(folder / "srdf/pr2.srdf"),
+            "-o", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    written = yaml.safe_load(out.read_text())
+    assert written["robot"]["base"] == {"type": "planar", "name": "world_joint",
+                                        "bounds": [[-2.0, 2.0], [-1.5, 1.5]]}  # fmt: skip
+    np.testing.assert_allclose(written["start"]["joints"], [-1.0, 0.2, 3.0, 0.1], atol=1e-12)
+    scenario = load_scenario(out)
+    result = plan(scenario, time_limit=10.0, seed=1)
+    assert result.solved
+    states = np.array(result.states).reshape(-1, scenario.arm.dof)
+    assert not verify_arm_path(scenario.arm, scenario.obstacles, states).collides
+    del request["workspace_parameters"]
+    (tmp_path / "request.yaml").write_text(yaml.safe_dump(request))
+    assert main(argv) == 2
+    assert "workspace_parameters: expected the bounds of the base world_joint" in (
+        capsys.readouterr().err)
+
+
+def test_pair_proofs_are_cached_on_disk_for_the_arm_as_the_kernel_reads_it(tmp_path, monkeypatch):
+    """A PR2's 1,044 pairs take seconds to prove: the proofs are kept per machine, keyed by
+    everything the kernel reads; a new process reads them back alike, and an arm with
+    other limits is proven anew."""
+    from kcplan.arm import pairs as pairs_module
+
+    monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
+    urdf = _urdf(tmp_path, "revolute", '<limit lower="-3" upper="3" effort="1" velocity="1"/>')
+    urdf.write_text(urdf.read_text().replace(
+        "</robot>", '<link name="d"><collision><origin xyz="0.95 0 0"/><geometry><box '
+        'size="0.1 0.1 0.1"/></geometry>'
+        '</collision></link><joint name="bend" type="revolute"><parent link="b"/><child '
+        'link="d"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/><limit lower="-3.14" upper="3.14" '
+        'effort="1" velocity="1"/></joint></robot>'))  # fmt: skip
+    arm = load_arm(urdf, ["spin", "bend"])
+    first = pairs_module.prove_pairs(arm)
+    assert [p.verdict for p in first] == ["touches"]  # d folds back onto a
+    assert len(list((tmp_path / "pairs").glob("*.npz"))) == 1
+    calls = []
+    monkeypatch.setattr(pairs_module, "_write", lambda *a: calls.append(a))
+    again = pairs_module.prove_pairs(load_arm(urdf, ["spin", "bend"]))  # from disk
+    assert again == first and not calls
+    narrow = urdf.read_text().replace('lower="-3.14" upper="3.14"', 'lower="-0.5" upper="0.5"')
+    (tmp_path / "narrow.urdf").write_text(narrow)
+    other = pairs_module.prove_pairs(load_arm(tmp_path / "narrow.urdf", ["spin", "bend"]))
+    assert [p.verdict for p in other] == ["apart"] and len(calls) == 1  # proven anew

@@ -393,6 +393,16 @@ CASES.append(
 )
 
 CASES.append(
+    Case(  # needs example-robot-data (the dev extra has it)
+        "make_whole_body_problems.py",
+        (str(ROOT / "scenarios" / "arm" / "example_pr2_doorway.yaml"), "--problems", "1",
+         "--across", "world_joint/x", "-o", "{tmp}"),  # fmt: skip
+        (r"pr2_doorway_1\.yaml$",),
+        ("pr2_doorway_1.yaml",),
+    )
+)
+
+CASES.append(
     Case(
         "pair_proofs.py",
         ("--robot", "panda", "--max-boxes", "400"),

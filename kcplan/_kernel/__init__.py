@@ -45,7 +45,10 @@ variables.
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import weakref
+from pathlib import Path
 
 import numpy as np
 
@@ -87,6 +90,7 @@ __all__ = [
     "build_kernel_arm",
     "build_kernel_world",
     "kernel_chain",
+    "kernel_digest",
     "kernel_robot",
 ]
 
@@ -194,6 +198,14 @@ def add_obstacles(world: _core.World, obstacles, n: int) -> None:
 
 
 _CHAINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+@functools.lru_cache(maxsize=1)
+def kernel_digest() -> str:
+    """A digest of the compiled kernel's file: what a cache of the kernel's results (the
+    self pairs' proofs, :mod:`kcplan.arm.pairs`) keys on, so that a rebuilt kernel never
+    reuses another's results."""
+    return hashlib.sha256(Path(_core.__file__).read_bytes()).hexdigest()
 
 
 def kernel_chain(arm) -> _core.Chain:

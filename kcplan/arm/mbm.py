@@ -11,6 +11,14 @@ A problem is two YAML files (``sceneNNNN.yaml``, ``requestNNNN.yaml``; see
   ``goal_constraints[0].joint_constraints`` (one goal configuration of the planning
   group, whose joints are the goal's, in the order given).
 
+A moving base: MoveIt names a planar virtual joint ``N``'s variables ``N/x``, ``N/y`` and
+``N/theta``; a request gives the base's start as ``start_state.multi_dof_joint_state``
+(``joint_names``, ``transforms``: ``translation`` x, y, z and ``rotation`` x, y, z, w; the
+yaw is the rotation's about z) and its goal as joint constraints of those names, and the
+base's x and y bounds are the request's ``workspace_parameters`` (MoveIt bounds a planar
+joint by them). A goal that names them makes the scenario's ``robot.base``
+(:mod:`kcplan.arm.description`).
+
 Obstacles come back as :class:`kcplan.world.obstacles.Obstacle` (kinds ``box``,
 ``sphere`` and ``cylinder``; a cylinder's ``extents`` are ``(r, r, h / 2)``).
 """
@@ -74,6 +82,8 @@ class MbmProblem:
     names : tuple of str
         The scene's ``id`` of each obstacle (an object of several primitives names each),
         e.g. ``Can1``, the object a table_pick problem grasps.
+    workspace : ((float, float, float), (float, float, float)) or None
+        The request's ``workspace_parameters``: its min and max corners (metres).
     """
 
     obstacles: tuple[Obstacle, ...]
@@ -83,6 +93,7 @@ class MbmProblem:
     start_state: dict
     allowed: frozenset
     names: tuple[str, ...] = ()
+    workspace: tuple[tuple[float, ...], tuple[float, ...]] | None = None
 
 
 def _field(data, path: str, source: str):
@@ -153,6 +164,7 @@ def _problem(scene: dict, request: dict, scene_source: str, request_source: str)
     if len(names) != len(positions):
         raise MbmError(f"{request_source}: start_state.joint_state: expected a position per name")
     start_state = {str(n): float(p) for n, p in zip(names, positions, strict=True)}
+    start_state |= _base_variables(request, request_source)
     goals = request.get("goal_constraints") or []
     if not goals or not goals[0].get("joint_constraints"):
         raise MbmError(f"{request_source}: goal_constraints[0].joint_constraints: expected it")
@@ -166,7 +178,37 @@ def _problem(scene: dict, request: dict, scene_source: str, request_source: str)
     start = np.array([start_state[j] for j in joints])
     goal = np.array([float(c["position"]) for c in constraints])
     obstacles, names = _obstacles(scene, scene_source)
-    return MbmProblem(obstacles, joints, start, goal, start_state, _allowed(scene), names)
+    corners = request.get("workspace_parameters") or {}
+    workspace = None
+    try:
+        low, high = corners["min_corner"], corners["max_corner"]
+        workspace = (tuple(map(float, low)), tuple(map(float, high)))
+    except (KeyError, TypeError, ValueError):
+        pass  # none given: a moving base then has no bounds (refused by mbm_scenario)
+    return MbmProblem(obstacles, joints, start, goal, start_state, _allowed(scene), names,
+                      workspace)  # fmt: skip
+
+
+def _base_variables(request: dict, source: str) -> dict[str, float]:
+    """``N/x``, ``N/y``, ``N/theta`` of every joint ``N`` of the start state's
+    ``multi_dof_joint_state`` (module docstring)."""
+    state = (request.get("start_state") or {}).get("multi_dof_joint_state") or {}
+    names, transforms = state.get("joint_names") or [], state.get("transforms") or []
+    if len(names) != len(transforms):
+        raise MbmError(f"{source}: start_state.multi_dof_joint_state: expected a transform "
+                       "per joint name")  # fmt: skip
+    out = {}
+    for name, transform in zip(names, transforms, strict=True):
+        try:
+            tx, ty = (float(v) for v in transform["translation"][:2])
+            qx, qy, qz, qw = (float(v) for v in transform["rotation"])
+        except (KeyError, TypeError, ValueError):
+            raise MbmError(f"{source}: start_state.multi_dof_joint_state.transforms: "
+                           "expected translation [x, y, z] and rotation [x, y, z, w]"
+                           ) from None  # fmt: skip
+        yaw = np.arctan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+        out |= {f"{name}/x": tx, f"{name}/y": ty, f"{name}/theta": float(yaw)}
+    return out
 
 
 def _load(text: str | bytes, source: str) -> dict:
@@ -276,12 +318,25 @@ def mbm_scenario(
     None: kcplan's default, each link its own convex hull (:mod:`kcplan.arm.hulls`).
     ``package_dirs`` (folders of ``package://`` URIs) are written relative to the folder
     of ``output``."""
-    import pinocchio as pin
+    from kcplan.arm.description import PlanarBase
+    from kcplan.arm.model import ArmError, urdf_model
 
     folder = Path(output).resolve().parent
     if not Path(urdf).is_file():
         raise MbmError(f"{os.fspath(urdf)}: urdf: expected an existing URDF file")
-    model = pin.buildModelFromUrdf(os.fspath(urdf))
+    bases = sorted({j.rsplit("/", 1)[0] for j in problem.joints
+                    if j.endswith(("/x", "/y", "/theta"))})  # fmt: skip
+    base = None
+    if bases:  # the goal moves a planar virtual joint: the base drives
+        if problem.workspace is None:
+            raise MbmError(f"{name}: workspace_parameters: expected the bounds of the base "
+                           f"{bases[0]} (min_corner, max_corner), found none")  # fmt: skip
+        low, high = problem.workspace
+        base = PlanarBase(bases[0], ((low[0], high[0]), (low[1], high[1])))
+    try:
+        model = urdf_model(urdf, base)
+    except ArmError as err:
+        raise MbmError(str(err)) from None
     fixed = {
         joint: value
         for joint, value in problem.start_state.items()
@@ -291,6 +346,9 @@ def mbm_scenario(
     if srdf is not None:
         robot["srdf"] = os.path.relpath(Path(srdf).resolve(), folder)
     robot["joints"] = list(problem.joints)
+    if base is not None:
+        bounds = [list(b) for b in base.bounds]
+        robot["base"] = {"type": "planar", "name": base.name, "bounds": bounds}
     if package_dirs:
         robot["package_dirs"] = [os.path.relpath(Path(d).resolve(), folder) for d in package_dirs]
     if representation is not None:
