@@ -26,7 +26,10 @@ near one: from the same start, edges are drawn (up to :data:`GRAZE_TRIES`) until
 meets a state at which the certifier's bodies touch an obstacle (self-collision aside;
 :data:`GRAZE_STEPS` states along it, then bisection to the first such state), and it
 stops short of that state by a log-uniform fraction in :data:`GRAZE_BACK` of the stretch
-before it. Progress lines on stderr; a Markdown table on stdout::
+before it. ``--scenarios FILE ...`` takes the scenes of arm scenarios instead (one robot
+and planning group in all, e.g. a base that drives: issue 57's problems of
+``make_whole_body_problems.py``); a wrapping angle's edge turns the shorter way for the
+certifier and the re-check alike. Progress lines on stderr; a Markdown table on stdout::
 
     python scripts/arm_soundness.py [--robot panda] [--edges 100000] [--seed 1]
         [--per-class 100] [--representation R] [--bodies 2] [--max-offset D] [--twin 0]
@@ -75,6 +78,7 @@ import math
 import os
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -85,6 +89,7 @@ from kcplan.arm.mbm import MBM_CLASSES, load_mbm_archive
 from kcplan.arm.verify import ArmMeshChecker
 from kcplan.certification.arm_certifier import DEFAULT_KC_INFLATION, ArmEdgeCertifier
 from kcplan.certification.kernel import KernelArmCertifier
+from kcplan.scenarios import load_scenario
 from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import sample_surface_points, voxel_filter
 
@@ -148,8 +153,9 @@ def _graze(rng: np.random.Generator, decide, q1: np.ndarray, q2: np.ndarray):
     invalid (:data:`GRAZE_STEPS` states, then bisection), by a log-uniform fraction in
     :data:`GRAZE_BACK` of the valid stretch: it ends near the obstacles as ``decide``
     sees them (:func:`study`: the certifier's, self-collision aside). ``q1 -> q2`` as it
-    is (not grazing) when none of those states is invalid."""
-    dq = q2 - q1
+    is (not grazing) when none of those states is invalid. A wrapping angle turns the
+    shorter way, as the certifier's edge does."""
+    dq = decide.world.arm.edge_end(q1, q2) - q1
     steps = np.linspace(0.0, 1.0, GRAZE_STEPS + 1)
     for i in range(1, len(steps)):
         if not decide.state_valid(q1 + steps[i] * dq):
@@ -167,11 +173,26 @@ def _graze(rng: np.random.Generator, decide, q1: np.ndarray, q2: np.ndarray):
     return q1, q1 + lo * (1.0 - back) * dq, True
 
 
-def study(args: argparse.Namespace, out=sys.stderr) -> dict:
-    """Decide and verify ``args.edges`` random edges; the counts (module docstring)."""
-    rng = np.random.default_rng(args.seed)
+@dataclass(frozen=True)
+class ScenarioScene:
+    """A scenario's scene as a problem of the study (``--scenarios``): its obstacles, its
+    allowed pairs and its goal (for messages)."""
+
+    obstacles: tuple
+    allowed: frozenset
+    goal: np.ndarray
+
+
+def _problems(args: argparse.Namespace) -> tuple[list, object]:
+    """The scenes in turn and the arm: the MBM problems of ``--robot``, or the scenes of
+    ``--scenarios`` (one robot, the first scenario's)."""
+    if args.scenarios:
+        scenarios = [load_scenario(path) for path in args.scenarios]
+        arm = scenarios[0].arm
+        if any(s.arm.urdf != arm.urdf or s.arm.joints != arm.joints for s in scenarios):
+            raise SystemExit("--scenarios: expected one robot and planning group in all")
+        return [ScenarioScene(s.obstacles, s.allowed, s.goal) for s in scenarios], arm
     folder = Path(args.mbm) / args.robot
-    t0 = time.perf_counter()
     keys = [(c, i) for c in MBM_CLASSES for i in range(1, args.per_class + 1)]
     problems = load_mbm_archive(folder / "problems.tar.bz2", keys)
     chosen = [
@@ -186,6 +207,22 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
                    fixed=_known(folder / f"{args.robot}.urdf", fixed),
                    bodies_per_link=args.bodies, max_offset=args.max_offset,
                    representation=args.representation)  # fmt: skip
+    return chosen, arm
+
+
+def _source(args: argparse.Namespace) -> str:
+    """Where the problems came from, for the report."""
+    if args.scenarios:
+        return "scenarios " + ", ".join(path.name for path in args.scenarios[:3]) + (
+            ", ..." if len(args.scenarios) > 3 else "")
+    return f"{args.per_class} per class"
+
+
+def study(args: argparse.Namespace, out=sys.stderr) -> dict:
+    """Decide and verify ``args.edges`` random edges; the counts (module docstring)."""
+    rng = np.random.default_rng(args.seed)
+    t0 = time.perf_counter()
+    chosen, arm = _problems(args)
     if args.attach:
         arm = attach(arm, [held_part(args.robot, args.attach)])
     print(f"{len(chosen)} problems, {arm.describe()}, {len(arm.self_pairs)} self pairs, "
@@ -403,7 +440,8 @@ def held_part(robot: str, shape: str) -> Attached:
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """The command line's arguments, checked (``study``'s ``args``)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--robot", choices=("panda", "ur5"), default="panda")
+    parser.add_argument("--robot", default="panda",
+                        help="panda or ur5 (MBM robots); with --scenarios, the table label")
     parser.add_argument("--edges", type=int, default=100_000)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--per-class", type=int, default=100, help="problems per class")
@@ -443,7 +481,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="fraction of the edges made to end near an obstacle, just "
                         "short of the certifier's first state touching it (0: none)")  # fmt: skip
     parser.add_argument("--mbm", default=os.fspath(MBM), help="folder of the MBM robots")
+    parser.add_argument("--scenarios", nargs="+", type=Path, metavar="SCENARIO",
+                        help="the scenes of these arm scenarios instead of MBM's (one robot: "
+                        "a moving base, two arms)")  # fmt: skip
     args = parser.parse_args(argv)
+    if not args.scenarios and args.robot not in ("panda", "ur5"):
+        parser.error(f"--robot: expected panda or ur5 (or --scenarios), got {args.robot!r}")
     if not 0.0 <= args.graze <= 1.0:
         parser.error("expected 0 <= --graze <= 1")
     if args.cloud < 0 or not (math.isfinite(args.spacing) and args.spacing >= 0.0):
@@ -485,7 +528,7 @@ def main(argv: list[str] | None = None) -> int:
               "kernel) | |")  # fmt: skip
     print()
     print(
-        f"- {r['problems']} problems ({args.per_class} per class), {r['arm'].describe()}, "
+        f"- {r['problems']} problems ({_source(args)}), {r['arm'].describe()}, "
         f"seed {args.seed}; KC inflation {args.kc_inflation}: {c['grown_queries']} KC guards "
         f"asked, {c['kc_reaches']} took a body farther than its ball"
         + (f"; planes: {c['plane_reaches']} took a body farther" if args.planes else "; no planes")

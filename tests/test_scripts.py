@@ -202,6 +202,15 @@ CASES = [
             r"; planes: \d+ took a body farther$",
         ),
     ),
+    Case(  # a base that drives (issue 57): the scenes of scenarios, the PR2's doorway
+        "arm_soundness.py",
+        ("--robot", "pr2", "--scenarios", str(ROOT / "scenarios/arm/example_pr2_doorway.yaml"))
+        + ("--edges", "6", "--representation", "hulls", "--graze", "0.5"),
+        (
+            r"^\| pr2 \| kernel \| 6 \| \d+ \| 0 \| ",
+            r"1 problems \(scenarios example_pr2_doorway\.yaml\), arm of 11 joints, 70 bodies ",
+        ),
+    ),
     Case(  # against point clouds (issue 55): filtered for the certifier, re-checked raw
         "arm_soundness.py",
         ("--edges", "14", "--per-class", "1", "--representation", "hulls", "--cloud", "100")
