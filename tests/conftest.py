@@ -92,6 +92,23 @@ PANDA = Path(__file__).resolve().parents[1] / "scenarios" / "arm" / "panda"
 PANDA_GROUP = [f"panda_joint{i}" for i in range(1, 8)]
 
 
+def _examples_installed() -> bool:
+    from kcplan.arm import ArmError
+    from kcplan.arm.examples import example_folder
+
+    try:
+        example_folder()
+    except ArmError:
+        return False
+    return True
+
+
+needs_examples = pytest.mark.skipif(
+    not _examples_installed(), reason="example-robot-data not installed (kcplan[robots])"
+)
+"""Skips a test of example-robot-data's robots where the optional extra is missing."""
+
+
 def panda_arm(bodies_per_link: int | None):
     """The bundled Panda's 7-joint group, ``bodies_per_link`` ellipsoids per link, fitted
     in the tests' private cover cache (once per test session and count); None: each link

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import needs_examples
 
-from kcplan.arm import ArmError
-from kcplan.arm.examples import EXAMPLE_ARMS, example_folder
+from kcplan.arm.examples import EXAMPLE_ARMS
 from kcplan.arm.verify import verify_arm_path
 from kcplan.planning.problem import plan
 from kcplan.scenarios import load_scenario, parse_scenario
@@ -16,12 +16,6 @@ from kcplan.world import ScenarioError
 
 ARM = Path(__file__).resolve().parents[1] / "scenarios" / "arm"
 
-try:
-    example_folder()
-    INSTALLED = True
-except ArmError:
-    INSTALLED = False
-needs_examples = pytest.mark.skipif(not INSTALLED, reason="example-robot-data not installed")
 
 
 @needs_examples

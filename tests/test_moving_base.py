@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import needs_examples
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -24,12 +25,6 @@ from kcplan.world import ScenarioError
 ARM = Path(__file__).resolve().parents[1] / "scenarios" / "arm"
 DOORWAY = ARM / "example_pr2_doorway.yaml"
 
-try:
-    example_folder()
-    INSTALLED = True
-except ArmError:
-    INSTALLED = False
-needs_examples = pytest.mark.skipif(not INSTALLED, reason="example-robot-data not installed")
 
 BASE = PlanarBase("world_joint", ((-3.0, 3.0), (-2.0, 2.0)))
 ARM_JOINTS = [f"r_{j}_joint" for j in ("shoulder_pan", "shoulder_lift", "upper_arm_roll",
@@ -52,9 +47,7 @@ def _urdf(tmp_path, kind="continuous", limit=""):
 
 
 @pytest.fixture(scope="module")
-def pr2():
-    if not INSTALLED:
-        pytest.skip("example-robot-data not installed")
+def pr2():  # every test that asks for it is marked needs_examples
     folder = example_folder() / "pr2_description"
     return load_arm(folder / "urdf/pr2.urdf", [*BASE.joints, "torso_lift_joint", *ARM_JOINTS],
                     srdf=folder / "srdf/pr2.srdf", base=BASE)  # fmt: skip
