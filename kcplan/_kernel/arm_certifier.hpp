@@ -151,6 +151,8 @@ class ArmCertifier {
   /// Whether the whole edge q1 -> q2 (dof() numbers each) is proven free. `with_probes`
   /// false skips step (4), which only rejects early and proves nothing: for an edge a
   /// lazy planner has screened already (screen()), whose probes would be asked again.
+  /// A wrapping angle (Chain::wraps) turns the shorter way: the edge proven, as screen()'s,
+  /// is q1 -> Chain::edge_end(q1, q2), the one OMPL's SO2StateSpace interpolates.
   bool check(const double* q1, const double* q2, bool with_probes = true);
   /// Whether the edge q1 -> q2 passes the collision queries check() begins with (both
   /// ends within the limits, q2 valid, no probe over the whole edge in contact: one per

@@ -84,7 +84,8 @@ class ScreenedArmMotions final : public ArmMotionValidator {
 
 /// The stock twin: q2, then states at most `step` apart (radians of joint-space
 /// distance, L2) in OMPL's DiscreteMotionValidator order (the midpoints of the intervals
-/// left, breadth first), one ArmWorld::in_collision query each, with no cap and no cache.
+/// left, breadth first), one ArmWorld::in_collision query each, with no cap and no cache;
+/// along q1 -> Chain::edge_end(q1, q2), as the certifier's edge.
 /// Not a proof: the edge may touch between two checked states.
 class DiscreteArmMotions final : public ArmMotionValidator {
  public:
