@@ -353,3 +353,21 @@ def test_pair_proofs_are_cached_on_disk_for_the_arm_as_the_kernel_reads_it(tmp_p
     (tmp_path / "narrow.urdf").write_text(narrow)
     other = pairs_module.prove_pairs(load_arm(tmp_path / "narrow.urdf", ["spin", "bend"]))
     assert [p.verdict for p in other] == ["apart"] and len(calls) == 1  # proven anew
+
+
+def test_robot_info_reads_a_base_that_drives(tmp_path, capsys):
+    from kcplan.cli import main
+
+    urdf = _urdf(tmp_path)
+    assert main(["robot", "info", str(urdf), "--base", "-1", "2", "-3", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "base base: planar, x in [-1, 2] m, y in [-3, 4] m, at most 0.5 m/s and 1 rad/s; " \
+        "joints base/x, base/y, base/theta (the yaw wraps)" in out
+    assert "  base/x: prismatic [-1.0, 2.0]\n" in out
+    assert "  base/theta: revolute [-3.141592653589793, 3.141592653589793] (an angle that " \
+        "wraps" in out
+    assert "  spin: revolute [-3.141592653589793, 3.141592653589793] (an angle that wraps" in out
+    assert main(["robot", "info", str(urdf), "--base", "1", "1", "-3", "4"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["--base: expected XMIN < XMAX and YMIN < YMAX (metres), got "
+                   "[1.0, 1.0, -3.0, 4.0]"]  # fmt: skip
