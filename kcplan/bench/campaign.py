@@ -224,6 +224,7 @@ def _failed(base: dict, status: str, reason: str, t0: float) -> dict:
         "solved": False,
         "time": None,
         "counters": {},
+        "progress": {},  # no samples: the spec's sampling interval is not a run's progress
         "wall": time.perf_counter() - t0,
     }
 
