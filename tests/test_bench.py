@@ -250,11 +250,15 @@ def test_crashed_hung_and_failing_workers_are_recorded_not_fatal(tmp_path):
 
 
 def test_worker_error_is_a_failed_run(tmp_path):
-    spec = campaign_specs([(OPEN, "open_field")], ["rrtconnect"], 1, 1, 1.0)[0]
+    from kcplan.bench.ompl_log import _progress_lines
+
+    spec = campaign_specs([(OPEN, "open_field")], ["rrtconnect"], 1, 1, 1.0, progress=0.1)[0]
     broken = spec.__class__(**{**spec.__dict__, "scenario": str(tmp_path / "missing.yaml")})
     record = run_isolated(broken, 60.0, WORKER_COMMAND)
     assert record["status"] == "error" and "missing.yaml" in record["reason"]
     assert record["solved"] is False
+    # no progress samples, not the spec's interval (which crashed the reports once)
+    assert record["progress"] == {} and _progress_lines([record]) == []
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
