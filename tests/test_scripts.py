@@ -413,6 +413,15 @@ CASES.append(
 
 CASES.append(
     Case(
+        "bench_totals.py",
+        (str(ROOT / "benchmarks" / "whole-body" / "pr2-bench" / "summary.csv"),),
+        (r"^\| kc-rrtconnect-lazy-native \| 10 \| 50 / 50 \| [\d.]+ \| 0 \|$",
+         r"^\| rrtconnect-32 \| 10 \| 50 / 50 \| [\d.]+ \| \d+ \|$"),  # fmt: skip
+    )
+)
+
+CASES.append(
+    Case(
         "pair_proofs.py",
         ("--robot", "panda", "--max-boxes", "400"),
         (
