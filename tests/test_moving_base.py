@@ -371,3 +371,31 @@ def test_robot_info_reads_a_base_that_drives(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["--base: expected XMIN < XMAX and YMIN < YMAX (metres), got "
                    "[1.0, 1.0, -3.0, 4.0]"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("kind", "bounds", "message"),
+    [
+        ("continuous", [[1.0, 1.0], [-1.0, 1.0]],
+         r"robot\.base\.bounds\.x: expected \[min, max\] with min < max \(metres\)"),
+        ("floating", [[-1.0, 1.0], [-1.0, 1.0]],
+         r"robot: .*r\.urdf: robot\.base: expected a URDF whose root does not move already, "
+         r"got the 'spin' joint of type floating"),
+    ],
+)  # fmt: skip
+def test_a_bad_base_is_one_line_and_exit_2(tmp_path, capsys, kind, bounds, message):
+    import re
+
+    import yaml
+
+    from kcplan.cli import main
+
+    _urdf(tmp_path, kind)
+    scenario = {"name": "bad", "robot": {"urdf": "r.urdf", "joints": ["base/x", "base/y"],
+                                         "base": {"type": "planar", "bounds": bounds}},
+                "start": {"joints": [0.0, 0.0]}, "goal": {"joints": [0.5, 0.0]}}  # fmt: skip
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(scenario))
+    assert main(["plan", str(tmp_path / "bad.yaml"), "-o", str(tmp_path / "p.json")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(message, err[0]), err
+    assert not (tmp_path / "p.json").exists()
