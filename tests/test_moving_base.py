@@ -399,3 +399,23 @@ def test_a_bad_base_is_one_line_and_exit_2(tmp_path, capsys, kind, bounds, messa
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and re.search(message, err[0]), err
     assert not (tmp_path / "p.json").exists()
+
+
+def test_pair_proofs_in_threads_are_the_proofs_in_one(monkeypatch):
+    """Many pairs are proven on every core, each part on its own world: the verdicts,
+    boxes and clearances are those of one thread (each pair's samples are seeded by its
+    place in the whole list)."""
+    from conftest import PANDA, PANDA_GROUP
+
+    from kcplan._kernel import _core, kernel_chain
+    from kcplan.arm import pairs as pairs_module
+
+    arm = load_arm(PANDA / "panda.urdf", PANDA_GROUP)  # no SRDF: 40 pairs
+    pairs = [(int(i), int(j)) for i, j in arm.self_pairs]
+    chain = kernel_chain(arm)
+    one = _core.prove_pairs_apart(_core.ArmWorld(chain, pairs, 0.0, 0.0), 300)
+    monkeypatch.setattr(pairs_module, "PARALLEL_PAIRS", 1)
+    monkeypatch.setattr(pairs_module.os, "cpu_count", lambda: 3)  # parts of 14, 14, 12
+    threaded = pairs_module._prove(_core, chain, pairs, 300)
+    assert [p[:3] for p in threaded] == [p[:3] for p in one]
+    assert {p[0] for p in one} >= {"apart", "touches"}  # both kinds of verdict compared

@@ -486,16 +486,21 @@ NB_MODULE(_core, m) {
 
   m.def(
       "prove_pairs_apart",
-      [](kcplan::ArmWorld& world, std::int64_t max_boxes) {
+      [](kcplan::ArmWorld& world, std::int64_t max_boxes, std::size_t first) {
+        std::vector<kcplan::PairProof> proofs;
+        {
+          nb::gil_scoped_release free;  // worlds of one chain may be proven in threads
+          proofs = kcplan::prove_pairs_apart(world, max_boxes, first);
+        }
         nb::list out;
         static const char* names[] = {"apart", "touches", "unknown"};
-        for (const kcplan::PairProof& p : kcplan::prove_pairs_apart(world, max_boxes))
+        for (const kcplan::PairProof& p : proofs)
           out.append(nb::make_tuple(names[p.verdict], p.boxes, p.least, p.witness));
         return out;
       },
-      "world"_a, "max_boxes"_a,
-      "(verdict, boxes, least clearance, witness) of each self pair of the world: "
-      "kcplan/_kernel/pair_proof.hpp");
+      "world"_a, "max_boxes"_a, "first"_a = 0,
+      "(verdict, boxes, least clearance, witness) of each self pair of the world, the "
+      "first's seed `first`: kcplan/_kernel/pair_proof.hpp");
 
   nb::class_<kcplan::ArmCertifier>(m, "ArmCertifier")
       .def(

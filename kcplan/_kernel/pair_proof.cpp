@@ -22,7 +22,8 @@ bool looser(const Box& a, const Box& b) { return a.slack() > b.slack(); }
 
 }  // namespace
 
-std::vector<PairProof> prove_pairs_apart(ArmWorld& world, std::int64_t max_boxes) {
+std::vector<PairProof> prove_pairs_apart(ArmWorld& world, std::int64_t max_boxes,
+                                         std::size_t first) {
   if (max_boxes < 1) throw std::invalid_argument("max_boxes: expected at least 1");
   const Chain& chain = world.chain();
   const std::size_t dof = static_cast<std::size_t>(chain.dof()), pairs = world.pairs().size();
@@ -55,7 +56,7 @@ std::vector<PairProof> prove_pairs_apart(ArmWorld& world, std::int64_t max_boxes
     };
     // a pair that touches mostly does so at many configurations: a few random ones
     // (seeded: the same verdicts every time) end its search sooner than the boxes would
-    std::mt19937 random(static_cast<unsigned>(m));
+    std::mt19937 random(static_cast<unsigned>(first + m));
     Box sample{chain.lower(), chain.upper()};
     bool touches = false;
     for (int i = 0; i < kWitnessSamples && !touches; ++i) {

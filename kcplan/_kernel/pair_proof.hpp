@@ -36,12 +36,16 @@ struct PairProof {
 /// that centre as the witness); after `max_boxes` centres the pair is kUnknown (and stays
 /// checked).
 ///
-/// Before the boxes, kWitnessSamples random configurations (seeded by the pair's index:
-/// the same verdicts on every run) look for a contact; they count as boxes.
+/// Before the boxes, kWitnessSamples random configurations (seeded by the pair's index,
+/// counted from `first`: the same verdicts on every run, and when a list of pairs is
+/// proven in parts, each part's world given its first pair's index) look for a
+/// contact; they count as boxes.
 ///
 /// Contract: the world's obstacles play no part (only self pairs are measured); the
 /// world's frames are moved (as by place()). max_boxes >= 1 (std::invalid_argument).
-std::vector<PairProof> prove_pairs_apart(ArmWorld& world, std::int64_t max_boxes);
+/// Reads the world's chain only: two worlds may be proven in two threads.
+std::vector<PairProof> prove_pairs_apart(ArmWorld& world, std::int64_t max_boxes,
+                                         std::size_t first = 0);
 
 /// Random configurations tried per pair before the branch and bound.
 constexpr int kWitnessSamples = 64;

@@ -15,14 +15,17 @@ per :class:`kcplan.arm.ArmModel` and kept with it for the process's life, and on
 the per-user cache (:func:`kcplan.cover.cache.cache_folder`, subfolder ``pairs``), keyed
 by everything the kernel reads of the arm, the pairs, the budget and a digest of the
 compiled kernel itself: a robot of thousands of pairs (a PR2's 1,044 take 5 s, a TIAGo
-dual's 6,877 45 s) pays once per machine, not once per ``kcplan plan``.
+dual's 6,877 45 s on one core) pays once per machine, not once per ``kcplan plan``; and
+from :data:`PARALLEL_PAIRS` pairs on they are proven on every core.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
 import weakref
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -86,7 +89,7 @@ def prove_pairs(
         path = _cache_path(arm, todo, max_boxes)
         results = _read(path, len(todo), arm.dof)
         if results is None:
-            results = _core.prove_pairs_apart(_core.ArmWorld(chain, todo, 0.0, 0.0), max_boxes)
+            results = _prove(_core, chain, todo, max_boxes)
             _write(path, results, arm.dof)
         for (i, j), (verdict, boxes, least, witness) in zip(todo, results, strict=True):
             links = (arm.bodies[i].link, arm.bodies[j].link)
@@ -97,6 +100,25 @@ def prove_pairs(
 
 
 VERDICTS = ("apart", "touches", "unknown")
+
+PARALLEL_PAIRS = 256
+"""Pairs from which the proofs run in a thread per core (at most 4), each on its own world
+of the chain (the kernel lets go of the GIL); their verdicts are the same as in one
+thread (each pair's random samples are seeded by its place in the whole list)."""
+
+
+def _prove(core, chain, pairs: list[tuple[int, int]], max_boxes: int) -> list:
+    """The kernel's proofs of ``pairs``, in parts on threads when there are many."""
+    parts = min(4, os.cpu_count() or 1) if len(pairs) >= PARALLEL_PAIRS else 1
+    size = -(-len(pairs) // parts)
+    starts = range(0, len(pairs), size)
+    worlds = [core.ArmWorld(chain, pairs[k : k + size], 0.0, 0.0) for k in starts]
+    if len(worlds) == 1:
+        return core.prove_pairs_apart(worlds[0], max_boxes)
+    with ThreadPoolExecutor(len(worlds)) as pool:
+        done = pool.map(lambda wk: core.prove_pairs_apart(wk[0], max_boxes, wk[1]),
+                        zip(worlds, starts, strict=True))  # fmt: skip
+        return [proof for part in done for proof in part]
 
 
 def _cache_path(arm: ArmModel, pairs: list[tuple[int, int]], max_boxes: int) -> Path:
