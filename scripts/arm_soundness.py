@@ -78,8 +78,8 @@ import math
 import os
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -173,10 +173,10 @@ def _graze(rng: np.random.Generator, decide, q1: np.ndarray, q2: np.ndarray):
     return q1, q1 + lo * (1.0 - back) * dq, True
 
 
-@dataclass(frozen=True)
-class ScenarioScene:
+class ScenarioScene(NamedTuple):
     """A scenario's scene as a problem of the study (``--scenarios``): its obstacles, its
-    allowed pairs and its goal (for messages)."""
+    allowed pairs and its goal (for messages). A named tuple: the tests load this script
+    by its path, where a dataclass cannot find its module."""
 
     obstacles: tuple
     allowed: frozenset
