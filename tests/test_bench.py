@@ -3,6 +3,7 @@
 import csv
 import json
 import math
+import os
 import signal
 import sqlite3
 import subprocess
@@ -17,6 +18,7 @@ from kcplan.bench.campaign import (
     WORKER_COMMAND,
     DaskExecutor,
     LocalExecutor,
+    _InterruptGate,
     campaign_specs,
     read_records,
     run_campaign,
@@ -259,6 +261,28 @@ def test_worker_error_is_a_failed_run(tmp_path):
     assert record["solved"] is False
     # no progress samples, not the spec's interval (which crashed the reports once)
     assert record["progress"] == {} and _progress_lines([record]) == []
+
+
+def test_an_interrupt_waits_until_the_record_is_kept():
+    # CI once saw runs.jsonl hold 2 records and summary.csv 1: the Ctrl-C fell between them
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    kept = []
+    try:
+        with pytest.raises(KeyboardInterrupt), _InterruptGate() as gate:
+            with gate.held():
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.05)  # the handler runs here, and must not raise
+                kept.append("line")
+                kept.append("list entry")
+        assert kept == ["line", "list entry"]
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        with pytest.raises(KeyboardInterrupt), _InterruptGate():
+            os.kill(os.getpid(), signal.SIGINT)  # outside a held section: at once
+            time.sleep(5)
+            kept.append("never")
+        assert "never" not in kept
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])

@@ -25,6 +25,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 from datetime import datetime
 from pathlib import Path
@@ -399,12 +400,13 @@ def run_campaign(
     out = Path(out_dir)
     records: list[dict] = []
     complete = True
-    with open(out / "runs.jsonl", "a") as log:
+    with open(out / "runs.jsonl", "a") as log, _InterruptGate() as gate:
         try:
             for record in executor.map(specs):
-                log.write(json.dumps(record) + "\n")
-                log.flush()
-                records.append(record)
+                with gate.held():  # the line and the list agree, even under Ctrl-C
+                    log.write(json.dumps(record) + "\n")
+                    log.flush()
+                    records.append(record)
                 if progress is not None:
                     progress.update(record)
                 if on_record is not None:
@@ -416,6 +418,53 @@ def run_campaign(
             if progress is not None:
                 progress.close()
     return records, complete
+
+
+class _InterruptGate:
+    """Defers ``KeyboardInterrupt`` out of the sections it holds.
+
+    Python raises ``KeyboardInterrupt`` between any two bytecodes, so a Ctrl-C between a
+    record's line in ``runs.jsonl`` and its entry in the returned list would report one
+    run fewer than the file holds. While the gate is entered, every signal whose handler
+    is :func:`signal.default_int_handler` (SIGINT, and SIGTERM when ``kcplan bench`` maps
+    it so) is caught here; inside :meth:`held` it is remembered and raised when the
+    section ends, elsewhere at once. Off the main thread, where handlers cannot be set,
+    the gate does nothing.
+    """
+
+    def __init__(self) -> None:
+        self._holding = False
+        self._pending = False
+        self._previous: dict[int, object] = {}
+
+    def __enter__(self) -> _InterruptGate:
+        if threading.current_thread() is threading.main_thread():
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                if signal.getsignal(signum) is signal.default_int_handler:
+                    self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self._holding:
+            self._pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextmanager
+    def held(self) -> Iterator[None]:
+        """A section no interrupt enters; one that arrives meanwhile is raised after it."""
+        self._holding = True
+        try:
+            yield
+        finally:
+            self._holding = False
+            if self._pending:
+                self._pending = False
+                raise KeyboardInterrupt
 
 
 def ordered(records: Iterable[dict], specs: Sequence[RunSpec]) -> list[dict]:
