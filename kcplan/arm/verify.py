@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from kcplan.arm.bounds import carries, chain_speeds, relative_speeds
@@ -76,6 +75,8 @@ def _file_mesh(path: str, scale: tuple[float, float, float]):
     vertex's distance from the mesh's origin and its convex hull (:func:`_convex_hull`);
     ``None`` for a format trimesh cannot read here (Collada without pycollada). Loaded
     once per process (the model is shared by the collision objects that place it)."""
+    import trimesh  # here: a plan that verifies no mesh never pays its 1.5 s import
+
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
     except (ImportError, ValueError, OSError):  # as the views (kcplan.views.arm) fall back
@@ -96,6 +97,8 @@ def _bvh_model(V: NDArray[np.float64], F: NDArray) -> tuple[fcl.BVHModel, float]
 def _convex_hull(V: NDArray[np.float64]) -> fcl.Convex | None:
     """The convex hull of points as an FCL solid, ``None`` when qhull cannot build one (a
     flat mesh)."""
+    import trimesh
+
     try:
         hull = trimesh.convex.convex_hull(V)
     except Exception:  # qhull's errors on flat input are of several kinds

@@ -20,7 +20,6 @@ the triangulation, for a piece that holds no features.
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike, NDArray
 
 from kcplan.cover.solid import Solid
@@ -66,6 +65,8 @@ def feature_segments(solid: Solid) -> tuple[NDArray, NDArray]:
         length), or the outline's turning angle at the corner.
     """
     if solid.dimension == 3:
+        import trimesh  # imported where used (kcplan.cover.fit's import cost)
+
         mesh = trimesh.Trimesh(solid.vertices, solid.faces, process=False)
         segments = np.asarray(mesh.vertices)[mesh.face_adjacency_edges]
         return segments, np.asarray(mesh.face_adjacency_angles, dtype=float)

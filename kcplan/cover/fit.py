@@ -80,10 +80,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import trimesh
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
-from scipy.stats import qmc
 
 from kcplan.cover.bodies import body_from_ellipsoid, body_holds, body_matrix
 from kcplan.cover.features import clip_segments, feature_segments, quantiles_along, simplex_normals
@@ -425,6 +423,8 @@ def _reflex_planes(solid: Solid) -> tuple[NDArray, NDArray, NDArray, float]:
     boundary = solid.boundary
     group, normals, offsets, total, surface = _plane_groups(boundary, oriented=True)
     if solid.dimension == 3:
+        import trimesh  # imported where used: 1.5 s that a plan on a fitted cover never needs
+
         mesh = trimesh.Trimesh(solid.vertices, solid.faces, process=False)
         pairs = np.asarray(mesh.face_adjacency)  # (a, 2): faces that share an edge
         angle = np.asarray(mesh.face_adjacency_angles, dtype=float)
@@ -514,6 +514,8 @@ class _Scorer:
         low, high = V.min(axis=0), V.max(axis=0)
         pad = 0.1 * (high - low)
         low, high = low - pad, high + pad
+        from scipy.stats import qmc  # 0.7 s of imports, needed when fitting only
+
         u = qmc.Sobol(solid.dimension, seed=0).random(SCORE_SAMPLES)
         u = u[np.argsort(u[:, 0], kind="stable")]  # by x, so a body's slab is a slice
         self.points = low + u * (high - low)
