@@ -211,7 +211,7 @@ FAULTY_WORKER = (
 def test_crashed_hung_and_failing_workers_are_recorded_not_fatal(tmp_path):
     specs = campaign_specs([(OPEN, "open_field")], ["rrtconnect"], 4, 1, 2.0)
     t0 = time.perf_counter()
-    records, complete = run_campaign(specs, tmp_path, LocalExecutor(2, 12.0, FAULTY_WORKER))
+    records, complete = run_campaign(specs, tmp_path, LocalExecutor(2, 8.0, FAULTY_WORKER))
     assert complete and time.perf_counter() - t0 < 120
     by_run = {r["run"]: r for r in records}
     assert by_run[0]["status"] == "ok" and by_run[0]["solved"]

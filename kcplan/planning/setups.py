@@ -35,8 +35,7 @@ from kcplan.planning.names import ARM_RANGE, RIGID_RANGE
 from kcplan.planning.states import (
     joint_reader,
     joint_space,
-    joint_state,
-    set_joint_state,
+    joint_writer,
     set_state,
     state_pose,
     state_space,
@@ -199,7 +198,8 @@ class ArmSetup(ProblemSetup):
         self.world.reset_counters()
         self.backend, self.joints = spec.backend, arm.joints
         self._open(joint_space(arm.lower, arm.upper, arm.wraps))
-        n = arm.dof
+        self._joints = joint_reader(arm.dof, arm.wraps)  # one layout for every state read
+        self._write = joint_writer(arm.dof, arm.wraps)
         if spec.kc:
             certificates = spec.arm_certificates or ARM_CERTIFICATES_OF.get(
                 spec.certificates, DEFAULT_ARM_CERTIFICATES
@@ -218,7 +218,7 @@ class ArmSetup(ProblemSetup):
             self.state_valid = PinChecker(arm, scenario.obstacles, scenario.allowed).is_valid
         elif spec.backend == "kernel":
             kernel, admits = self.world.kernel, self.world.kernel.chain.admits
-            joints = joint_reader(n, arm.wraps)  # as the kc validator reads them: a fair comparison
+            joints = self._joints  # as the kc validator reads them: a fair comparison
 
             def state_valid(state) -> bool:
                 q = joints(state)
@@ -226,10 +226,10 @@ class ArmSetup(ProblemSetup):
 
             self.state_valid = state_valid
         else:
-            world = self.world
+            world, joints = self.world, self._joints
 
             def state_valid(state) -> bool:
-                q = joint_state(state, n, arm.wraps)
+                q = np.array(joints(state))
                 return arm.within_limits(q) and not world.in_collision(q)
 
             self.state_valid = state_valid
@@ -238,10 +238,10 @@ class ArmSetup(ProblemSetup):
             self.si.setStateValidityCheckingResolution(step)
 
     def read(self, state) -> NDArray[np.float64]:
-        return joint_state(state, self.arm.dof, self.arm.wraps)
+        return np.array(self._joints(state))
 
     def write(self, state, values) -> None:
-        set_joint_state(state, values, self.arm.wraps)
+        self._write(state, values)
 
     def timed(self, states: list, velocity_limits=None, acceleration_limits=None):
         from kcplan.trajectory import certified as trajectory

@@ -21,6 +21,7 @@ __all__ = [
     "joint_reader",
     "joint_space",
     "joint_state",
+    "joint_writer",
     "set_joint_state",
     "set_state",
     "state_pose",
@@ -99,9 +100,7 @@ def joint_state(state, dof: int, wraps: ArrayLike | None = None) -> np.ndarray:
     return np.array(joint_reader(dof, wraps)(state))
 
 
-def joint_reader(
-    dof: int, wraps: ArrayLike | None = None
-) -> Callable[[object], tuple[float, ...]]:
+def joint_reader(dof: int, wraps: ArrayLike | None = None) -> Callable[[object], tuple[float, ...]]:
     """A function reading the ``dof`` joint values of a state of :func:`joint_space` as a
     tuple. For a ``RealVectorStateSpace``: ``operator.itemgetter``, whose ``dof`` reads
     run in C (0.5 µs for 7 joints against 1.5 µs for a list comprehension, on every state
@@ -130,18 +129,32 @@ def set_joint_state(state, q: ArrayLike, wraps: ArrayLike | None = None) -> None
     """Write a joint vector into a state of :func:`joint_space` (a wrapping angle brought
     into ``[-pi, pi)``)."""
     q = np.asarray(q, dtype=float)
-    runs = _runs(len(q), wraps)
+    joint_writer(len(q), wraps)(state, q)
+
+
+def joint_writer(dof: int, wraps: ArrayLike | None = None) -> Callable[[object, ArrayLike], None]:
+    """A function writing ``dof`` joint values into a state of :func:`joint_space` (the
+    layout worked out once: :func:`set_joint_state` for many states)."""
+    runs = _runs(dof, wraps)
     if len(runs) == 1 and not runs[0][0]:
-        for j, value in enumerate(q):
-            state[j] = float(value)
-        return
-    for k, (wrap, joints) in enumerate(runs):
-        part = state[k]
-        if wrap:
-            part.value = float(wrapped(q[joints.start]))
-        else:
-            for i, j in enumerate(joints):
-                part[i] = float(q[j])
+
+        def write_box(state, q: ArrayLike) -> None:
+            for j, value in enumerate(np.asarray(q, dtype=float)):
+                state[j] = float(value)
+
+        return write_box
+
+    def write(state, q: ArrayLike) -> None:
+        q = np.asarray(q, dtype=float)
+        for k, (wrap, joints) in enumerate(runs):
+            part = state[k]
+            if wrap:
+                part.value = float(wrapped(q[joints.start]))
+            else:
+                for i, j in enumerate(joints):
+                    part[i] = float(q[j])
+
+    return write
 
 
 def set_state(state, pose: ArrayLike, n: int) -> None:

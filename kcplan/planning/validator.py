@@ -36,15 +36,15 @@ Contract (OMPL's, as far as the Python binding allows):
 from __future__ import annotations
 
 from collections.abc import Sequence
-from functools import partial
 
-from numpy.typing import ArrayLike
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from ompl import base as ob
 
 from kcplan.arm.world import ArmWorld
 from kcplan.certification.certifiers import certifier_for
 from kcplan.geometry.robot import Robot
-from kcplan.planning.states import joint_reader, joint_state, state_pose
+from kcplan.planning.states import joint_reader, state_pose
 
 __all__ = ["KCMotionValidator"]
 
@@ -103,13 +103,15 @@ class KCMotionValidator(ob.MotionValidator):
         motion for a rigid robot), which proves nothing; a lazy planner sets it while
         its trees grow and certifies the path it returns (:mod:`kcplan.planning.lazy`)."""
         arm = isinstance(world, ArmWorld)
-        wraps = world.arm.wraps if arm else None
-        self._read = partial(joint_state, wraps=wraps) if arm else state_pose
+        if arm:  # the state's layout worked out once, not per state read
+            self._joints = joint_reader(self.n, world.arm.wraps)
+            self._read = self._read_joints
+        else:
+            self._read = state_pose
         if self.backend != "kernel":
             return
         # the hot paths: one call into the kernel with the state's floats, nothing else
         if arm:
-            self._joints = joint_reader(self.n, wraps)
             self.state_valid, self.checkMotion = self._valid_kernel_arm, self._check_kernel_arm
         elif self.n == 2:
             self.state_valid = self._valid_kernel_se2
@@ -119,6 +121,9 @@ class KCMotionValidator(ob.MotionValidator):
             self.state_valid = self._valid_kernel_se3
             if self.certifier.fallback != "discrete":
                 self.checkMotion = self._check_kernel_se3
+
+    def _read_joints(self, state, n: int) -> NDArray[np.float64]:
+        return np.array(self._joints(state))
 
     def _valid_kernel_arm(self, state) -> bool:
         return self.certifier.compiled.state_valid(self._joints(state))
