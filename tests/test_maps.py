@@ -45,9 +45,8 @@ HRM_PROBLEMS = (
     + [("superellipse_maze1", 2, "rabbit"), ("ellipse_sparse", 2, "S_shape")]
     + [("ellipsoid_cluttered", 3, "chair"), ("ellipsoid_maze", 3, "snake")]
     + [("ellipsoid_sparse", 3, "chair"), ("superquadrics_sparse", 3, "rabbit2")]
-    + [("superquadrics_narrow", 3, "rabbit")]
     + [pytest.param(f"superquadrics_{m}", 3, "rabbit", marks=pytest.mark.study)
-       for m in ("cluttered", "maze")]
+       for m in ("narrow", "cluttered", "maze")]
     + [pytest.param("superquadrics_home", 3, "tree", marks=pytest.mark.study)]
 )
 """Map and robot pairs whose start and goal are free (HRM's settings are per map, not per
