@@ -7,10 +7,13 @@ clearances by dense boundary sampling refined with a scalar minimiser).
 """
 
 import math
+from pathlib import Path
 
 import fcl
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import minimize_scalar
 from scipy.spatial import ConvexHull
 
@@ -413,3 +416,79 @@ def test_thin_ellipsoid_clearance_is_a_lower_bound_where_fcl_overestimates():
     assert world.safe_clearance(pose) <= sampled
     (region,) = world.free_regions(pose, horizon=1.0)
     assert 0.0 < region.clearances.max() <= sampled
+
+
+def test_fcl_near_contact_is_climbed_to_its_distance_not_taken_for_contact():
+    """Found by a suite run: an ellipsoid 0.3-0.7 mm from a box of box_field, where FCL's
+    nearest points (both orders) give a direction whose separation bound is <= 0, so the
+    clearance was 0 and the gap-free verifier called a free certified edge colliding.
+    The bound is now climbed from FCL's direction (:func:`ascended_separation`): still
+    below the distance, which dense samples of the ellipsoid's surface bound from above."""
+    from kcplan.scenarios import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    scenario = load_scenario(root / "scenarios" / "3d" / "box_field.yaml")
+    world = CollisionWorld(scenario)
+    pose = np.array([57.59605363295599, 38.61278549417023, 38.19139306563642,
+                     -0.08675687865065408, -0.02803656084155149, -0.34795178501123286,
+                     0.9330684597447663])  # fmt: skip
+    R, t = pose_frame(pose, 3)
+    u = np.random.default_rng(0).normal(size=(400_000, 3))
+    surface = (u / np.linalg.norm(u, axis=1)[:, None] * scenario.robot.semi_axes) @ R.T + t
+    sampled = min(  # an upper bound of the true distance
+        np.linalg.norm(
+            np.maximum(np.abs((surface - o.center) @ o.rotation) - o.extents, 0.0), axis=1
+        ).min()
+        for o in scenario.obstacles
+    )
+    assert not world.in_collision(pose)
+    assert 1e-4 < world.clearance(pose) <= sampled < 1e-3
+
+
+@settings(max_examples=60)
+@given(
+    axes=st.lists(st.floats(0.1, 3.0), min_size=3, max_size=3),
+    half=st.lists(st.floats(0.1, 5.0), min_size=3, max_size=3),
+    gap=st.floats(1e-5, 0.5),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_ascended_separation_stays_below_the_distance(axes, half, gap, seed):
+    """From any start direction the climbed bound stays a lower bound of the distance
+    between an ellipsoid and a box (the exact distance bounded from above by dense surface
+    samples), never below the start's."""
+    from scipy.spatial.transform import Rotation
+
+    from kcplan.world.support import (
+        EllipsoidSupport,
+        PointsSupport,
+        ascended_separation,
+        box_vertices,
+        separation,
+    )
+
+    rng = np.random.default_rng(seed)
+    a, h = np.array(axes), np.array(half)
+    Re, Rb = Rotation.random(2, random_state=seed).as_matrix()
+    # place the ellipsoid along a random direction, then slide it in until `gap` is near
+    direction = rng.normal(size=3)
+    direction /= np.linalg.norm(direction)
+    centre = direction * (np.linalg.norm(h) + a.max() + gap + 1.0)
+    box = PointsSupport(box_vertices(np.zeros(3), Rb, h))
+    u = rng.normal(size=(100_000, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    local = u * a @ Re.T
+
+    def sampled(c):
+        p = (local + c) @ Rb
+        return np.linalg.norm(np.maximum(np.abs(p) - h, 0.0), axis=1).min()
+
+    centre -= direction * max(sampled(centre) - gap, 0.0)
+    ellipsoid = EllipsoidSupport(centre, Re, a)
+    upper = sampled(centre)
+    start = rng.normal(size=3)
+    start /= np.linalg.norm(start)
+    value, v = ascended_separation(box, ellipsoid, start, target=np.inf)
+    assert value <= upper + 1e-12
+    assert value >= separation(box, ellipsoid, start) - 1e-15
+    assert np.isclose(np.linalg.norm(v), 1.0)
+    assert value == pytest.approx(separation(box, ellipsoid, v), abs=1e-15)

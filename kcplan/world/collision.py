@@ -42,7 +42,13 @@ from kcplan.world.obstacles import Obstacle
 from kcplan.world.pointcloud import CLOUD_KINDS
 from kcplan.world.region import FreeRegion
 from kcplan.world.scenario import Scenario, as_rigid_scenario
-from kcplan.world.support import EllipsoidSupport, box_vertices, piece_supports, separation
+from kcplan.world.support import (
+    EllipsoidSupport,
+    ascended_separation,
+    box_vertices,
+    piece_supports,
+    separation,
+)
 
 __all__ = [
     "CLEARANCE_RTOL",
@@ -368,6 +374,7 @@ class CollisionWorld:
         round too and the better bound kept."""
         body, n = self._bodies[k], self.dimension
         fcl_d, low, u, piece_support = math.inf, 0.0, None, None
+        tried = None  # FCL's first direction, whatever bound it gave
         for first, second in ((body, piece), (piece, body)):
             result = fcl.DistanceResult()
             d = fcl.distance(first, second, self._pair_request, result)
@@ -388,11 +395,18 @@ class CollisionWorld:
             if length == 0.0:
                 continue
             v = direction / length  # from the piece towards the body
+            tried = v if tried is None else tried
             bound = min(max(separation(piece_support, support, v), 0.0), d)
             if bound > low:
                 low, u = bound, v
             if low >= d * (1.0 - CLEARANCE_RTOL):  # the direction confirms FCL's distance
-                break
+                return fcl_d, low, u, piece_support
+        if tried is not None:  # neither order's direction confirms: climb from the better
+            bound, v = ascended_separation(
+                piece_support, support, tried if u is None else u, fcl_d * (1.0 - CLEARANCE_RTOL)
+            )
+            if bound > low:
+                low, u = min(bound, fcl_d), v
         return fcl_d, low, u, piece_support
 
     def _body_distance(self, k: int) -> float:

@@ -26,6 +26,7 @@ __all__ = [
     "PointsSupport",
     "box_vertices",
     "piece_supports",
+    "ascended_separation",
     "separation",
 ]
 
@@ -101,6 +102,58 @@ def separation(support_a, support_b, direction: NDArray) -> float:
     an iterative solver's inaccurate direction can only weaken it (negative: nothing
     known)."""
     return -support_b(-direction) - support_a(direction)
+
+
+def ascended_separation(
+    support_a, support_b, direction: NDArray, target: float, steps: int = 24
+) -> tuple[float, NDArray]:
+    """:func:`separation` raised by a local search over unit directions from ``direction``.
+
+    ``g(n) = -h_b(-n) - h_a(n)`` is concave (support functions are convex), so when the
+    distance is positive its maximum over the unit sphere is the only local one, and a
+    pattern search that keeps every improving turn climbs towards it. Every value found
+    is :func:`separation` at some unit direction: a certain lower bound whatever the
+    search does. Used when FCL's direction is too coarse near contact (an ellipsoid
+    0.4 mm from a metre-sized box: FCL said 0.4 mm, its direction's bound 0).
+
+    Parameters
+    ----------
+    direction : ndarray, shape (n,)
+        Unit start direction, from ``a`` towards ``b``.
+    target : float
+        Stop once the bound reaches it (e.g. FCL's distance less its tolerance).
+    steps : int
+        Turn sizes tried, halving from 0.05 rad.
+
+    Returns
+    -------
+    value : float
+        The best bound found (length units; negative: nothing known).
+    direction : ndarray, shape (n,)
+        Its unit direction.
+    """
+    v = np.asarray(direction, dtype=float)
+    v = v / np.linalg.norm(v)
+    best = separation(support_a, support_b, v)
+    n = len(v)
+    turn = 0.05
+    for _ in range(steps):
+        if best >= target:
+            break
+        # an orthonormal basis of the tangent plane at v (QR of [v, I])
+        basis = np.linalg.qr(np.column_stack([v, np.eye(n)]))[0][:, 1:n]
+        improved = True
+        while improved and best < target:
+            improved = False
+            for t in basis.T:
+                for sign in (1.0, -1.0):
+                    w = v + sign * turn * t
+                    w /= np.linalg.norm(w)
+                    value = separation(support_a, support_b, w)
+                    if value > best:
+                        best, v, improved = value, w, True
+        turn *= 0.5
+    return best, v
 
 
 def box_vertices(center: NDArray, rotation: NDArray, extents: NDArray) -> NDArray:
