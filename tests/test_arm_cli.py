@@ -205,10 +205,10 @@ def test_import_mbm_writes_the_bundled_problem(tmp_path, capsys):
     assert main([*argv[:7], "101", *argv[8:]]) == 2
     assert "expected one box scene 101, found 0" in capsys.readouterr().err
     # an offset cover: the scenario says so (a loose one here, 2 bodies at most: quick)
-    offset = [*argv[:-2], "--max-offset", "0.05", "--bodies-per-link", "2", "-o", str(out)]
+    offset = [*argv[:-2], "--max-offset", "0.08", "--bodies-per-link", "2", "-o", str(out)]
     assert main(offset) == 0, capsys.readouterr().err
     robot = yaml.safe_load(out.read_text())["robot"]
-    assert robot["max_offset"] == 0.05 and robot["bodies_per_link"] == 2
+    assert robot["max_offset"] == 0.08 and robot["bodies_per_link"] == 2
     assert main([*argv[:-2], "--max-offset", "-1", "-o", str(out)]) == 2
     assert "--max-offset" in capsys.readouterr().err
 

@@ -137,7 +137,7 @@ def command_lines(draw, folder: Path) -> tuple[list[str], list[Path]]:
 
 
 @settings(
-    max_examples=150,
+    max_examples=100,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
