@@ -128,8 +128,7 @@ def joint_reader(dof: int, wraps: ArrayLike | None = None) -> Callable[[object],
 def set_joint_state(state, q: ArrayLike, wraps: ArrayLike | None = None) -> None:
     """Write a joint vector into a state of :func:`joint_space` (a wrapping angle brought
     into ``[-pi, pi)``)."""
-    q = np.asarray(q, dtype=float)
-    joint_writer(len(q), wraps)(state, q)
+    joint_writer(len(q), wraps)(state, q)  # the writer makes q an array
 
 
 def joint_writer(dof: int, wraps: ArrayLike | None = None) -> Callable[[object, ArrayLike], None]:
