@@ -75,6 +75,15 @@ def test_a_continuous_joint_is_a_revolute_one_whose_angle_wraps(tmp_path):
     assert load_arm(limited, ["spin"]).wraps is None
 
 
+@pytest.mark.parametrize("kind, named", [("floating", "a floating joint"),
+                                         ("planar", "a planar joint")])
+def test_a_group_joint_kcplan_cannot_plan_is_named_by_its_urdf_kind(tmp_path, kind, named):
+    # the message of a scenario's joints and of an SRDF group's (kcplan.arm.model.plannable_joint)
+    with pytest.raises(ArmError, match=rf"r\.urdf: joints: 'spin' is {named}; expected "
+                                       r"revolute or prismatic joints with limits"):  # fmt: skip
+        load_arm(_urdf(tmp_path, kind), ["spin"])
+
+
 def test_a_base_on_a_urdf_whose_root_moves_is_refused(tmp_path):
     urdf = _urdf(tmp_path, "floating")
     with pytest.raises(ArmError, match=r"r\.urdf: robot\.base: expected a URDF whose root "

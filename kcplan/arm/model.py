@@ -82,6 +82,7 @@ __all__ = [
     "load_arm",
     "mesh_cover",
     "package_folders",
+    "plannable_joint",
     "self_pairs_of",
     "movable_joints",
     "urdf_model",
@@ -583,13 +584,34 @@ def _group(full, joints: Sequence[str], source: str) -> list[str]:
             raise ArmError(f"{source}: joints: {name!r} is not a joint of the URDF ({known})")
         if group.count(name) > 1:
             raise ArmError(f"{source}: joints: {name!r} is named twice")
-        shortname = full.joints[full.getJointId(name)].shortname()
-        if shortname not in JOINT_KINDS:
-            raise ArmError(
-                f"{source}: joints: {name!r} is a {shortname}; expected a revolute or "
-                "prismatic joint with limits"
-            )
+        plannable_joint(full, name, f"{source}: joints")
     return group
+
+
+def plannable_joint(model, joint: str, where: str) -> int:
+    """Joint ``joint``'s id in ``model`` (a ``pinocchio.Model`` that has it), when kcplan
+    can plan it: revolute (continuous included) or prismatic.
+
+    Raises
+    ------
+    ArmError
+        ``WHERE: 'joint' is a floating joint; expected ...`` for any other kind.
+    """
+    index = model.getJointId(joint)
+    shortname = model.joints[index].shortname()
+    if shortname not in JOINT_KINDS:
+        raise ArmError(f"{where}: {joint!r} is a {_joint_kind(shortname)}; expected revolute "
+                       "or prismatic joints with limits")  # fmt: skip
+    return index
+
+
+def _joint_kind(shortname: str) -> str:
+    """A Pinocchio joint kind as a URDF names it (``JointModelRUBX``: continuous)."""
+    if shortname.startswith("JointModelRUB"):
+        return "continuous joint"
+    names = {"JointModelFreeFlyer": "floating joint", "JointModelPlanar": "planar joint",
+             "JointModelSpherical": "spherical joint"}  # fmt: skip
+    return names.get(shortname, shortname)
 
 
 def hull_bodies(

@@ -200,13 +200,12 @@ def parse_arm_scenario(data: Any, source: str, directory: Path) -> ArmScenario:
                    None, f"{spec.get(key)!r}, which does not exist at {path}")  # fmt: skip
     semantic = _Semantic(r, urdf, srdf)
     base = _base(r, spec["base"], semantic) if "base" in spec else None
-    semantic.base = base
     if default_joints and "group" not in spec and "joints" not in spec:
         spec["joints"] = [*(base.joints if base else ()), *default_joints]  # an example's arm
     if "group" in spec:  # the spec keeps the group (written back as it was read)
         if "joints" in spec:
             r.fail("robot.group", "a group or joints, not both", spec["group"])
-        joints = list(semantic.joints(r.text(spec["group"], "robot.group")))
+        joints = list(semantic.joints(r.text(spec["group"], "robot.group"), base))
     else:
         joints = spec["joints"]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
@@ -282,7 +281,6 @@ class _Semantic:
 
     def __init__(self, r: FieldReader, urdf: Path, srdf: Path | None) -> None:
         self._r, self._urdf, self._srdf, self._read = r, urdf, srdf, None
-        self.base: PlanarBase | None = None  # the model a group is read against has it
 
     def planar_joint(self) -> str | None:
         """The name of the SRDF's planar virtual joint, if there is an SRDF with one."""
@@ -301,10 +299,11 @@ class _Semantic:
                 raise ScenarioError(f"{self._r.source}: robot: {err}") from None
         return self._read
 
-    def joints(self, group: str) -> tuple[str, ...]:
+    def joints(self, group: str, base: PlanarBase | None) -> tuple[str, ...]:
+        """The joints of ``group``, read against the URDF with the moving ``base``."""
         srdf = self._srdf_of("robot.group")
         try:
-            return srdf.group_joints(group, urdf_model(self._urdf, self.base))
+            return srdf.group_joints(group, urdf_model(self._urdf, base))
         except ArmError as err:  # the group, or a URDF Pinocchio cannot read
             raise ScenarioError(f"{self._r.source}: robot: {err}") from None
 

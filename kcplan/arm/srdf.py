@@ -30,7 +30,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-from kcplan.arm.model import JOINT_KINDS, ArmError
+from kcplan.arm.model import ArmError, plannable_joint
 
 __all__ = ["Srdf", "VirtualJoint", "read_srdf"]
 
@@ -210,24 +210,10 @@ def read_srdf(path: str | os.PathLike) -> Srdf:
     return Srdf(source, groups, states, tuple(virtual))
 
 
-def _kind(shortname: str) -> str:
-    """A Pinocchio joint kind as a URDF names it (``JointModelRUBX``: continuous)."""
-    if shortname.startswith("JointModelRUB"):
-        return "continuous joint"
-    names = {"JointModelFreeFlyer": "floating joint", "JointModelPlanar": "planar joint",
-             "JointModelSpherical": "spherical joint"}  # fmt: skip
-    return names.get(shortname, shortname)
-
-
 def _movable(model, joint: str, where: str) -> set[int]:
     """Joint ``joint``'s id when it is revolute or prismatic; nothing for a fixed joint."""
     if model.existJointName(joint):
-        index = model.getJointId(joint)
-        kind = model.joints[index].shortname()
-        if kind not in JOINT_KINDS:
-            raise ArmError(f"{where}: {joint!r} is a {_kind(kind)}; expected revolute or "
-                           "prismatic joints with limits")  # fmt: skip
-        return {index}
+        return {plannable_joint(model, joint, where)}
     if model.existFrame(joint) and _is_fixed_joint(model, model.getFrameId(joint)):
         return set()
     raise ArmError(f"{where}: {joint!r} is not a joint of the URDF")

@@ -202,8 +202,9 @@ def _print_srdf(srdf, model, base=None) -> None:
         try:
             print(f"  {name}: {', '.join(srdf.group_joints(name, model))}")
         except ArmError as err:  # said, not fatal: another group may be the one asked
-            # the message less its "SRDF: group 'NAME'" prefix, said on the line already
-            print(f"  {name}: not plannable: {str(err).split(': ', 2)[-1]}")
+            # the message less its "SRDF: group 'NAME': " prefix, said on the line already
+            reason = str(err).removeprefix(f"{srdf.source}: ").removeprefix(f"group {name!r}: ")
+            print(f"  {name}: not plannable: {reason}")
     if srdf.states:
         states = ", ".join(f"{state} ({group})" for group, state in srdf.states)
         print(f"named states (group): {states}")
