@@ -24,9 +24,9 @@ __all__ = [
     "CylinderSupport",
     "EllipsoidSupport",
     "PointsSupport",
+    "ascended_separation",
     "box_vertices",
     "piece_supports",
-    "ascended_separation",
     "separation",
 ]
 
