@@ -1,4 +1,4 @@
-"""RESULTS 34.2: the same work on every kernel: a guard's clearances (`safe_clearances`)
+"""RESULTS 34.3: the same work on every kernel: a guard's clearances (`safe_clearances`)
 and a state check (`in_collision`) on 400 fixed states of each of 14 MotionBenchMaker
 Panda clouds (classes x indices 1 and 3; states about the start-goal line), best of 5
 passes, and the clouds' counters. Swap the kernel's module between runs to compare.

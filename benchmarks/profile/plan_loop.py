@@ -1,5 +1,5 @@
 """Plans of MotionBenchMaker Panda problems, on their primitives or as clouds, repeated in
-one process: what `perf record` samples in RESULTS 34 (run.sh). Prints the medians of the
+one process: what `perf record` samples in RESULTS 34.2 (run.sh). Prints the medians of the
 whole call, the solve and the shortcuts.
 
     python benchmarks/profile/plan_loop.py [--prims] [--seeds N] [--problems CLASS:I,...]
