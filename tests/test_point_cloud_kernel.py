@@ -26,9 +26,13 @@ SURFACE = 4000
 UNIT = sphere_points(SURFACE)
 
 
-def _world(points: np.ndarray, radius: float, axes, order=CloudOrder.morton) -> KernelWorld:
+def _world(points: np.ndarray, radius: float, axes, order=CloudOrder.morton,
+           tolerance: float = 0.0) -> KernelWorld:  # fmt: skip
+    """A world of one ellipsoid and the cloud, no allowance (rtol = atol = 0): the
+    tolerance's floor is the padding."""
     world = KernelWorld(KernelRobot(3, list(map(float, axes)), [0, 0, 0, 0, 0, 0, 1]), 1.0, 0, 0)
     world.add_points(np.ascontiguousarray(points, dtype=float), radius, order)
+    world.cloud_tolerance = tolerance
     world.finalize()
     return world
 
@@ -72,16 +76,22 @@ def clouds(draw):
     return points, radius, axes, [*position, *q]
 
 
+TOLERANCES = st.sampled_from([0.0, 0.25, 1.0])
+
+
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(clouds(), st.sampled_from([CloudOrder.morton, CloudOrder.median]))
-def test_the_tree_finds_what_measuring_every_point_finds(case, order):
+@given(clouds(), st.sampled_from([CloudOrder.morton, CloudOrder.median]), TOLERANCES)
+def test_the_tree_finds_what_measuring_every_point_finds(case, order, tolerance):
     points, radius, axes, pose = case
-    world = _world(points, radius, axes, order)
+    world = _world(points, radius, axes, order, tolerance)
     brute = _coal_distances(points, radius, axes, pose)
     (d,) = world.body_distances(pose)
     # coal's GJK stops a little above the distance (within the kernel's allowance, and
-    # within its tolerance, 1e-6, of another GJK run); a ball's bound is the distance
-    assert brute.min() * (1.0 - COAL_CLEARANCE_RTOL) - 1e-9 <= d <= brute.min() * (1 + 1e-6) + 2e-6
+    # within its tolerance, 1e-6, of another GJK run); a ball's bound is the distance.
+    # With a tolerance t (floor 0 here) the search may stop early: d (1 + t) still
+    # reaches the distance, and d stays below it
+    assert brute.min() * (1.0 - COAL_CLEARANCE_RTOL) - 1e-9 <= d * (1.0 + tolerance)
+    assert d <= brute.min() * (1 + 1e-6) + 2e-6
     # the verdict: contact exactly where some ball is within GJK's tolerance of the body
     assert world.in_collision(pose) == bool(brute.min() < 1e-6)
     # the tree bounded most points without measuring them
@@ -116,6 +126,30 @@ def test_a_ball_is_measured_exactly(case, ball):
     (d,) = world.body_distances(pose)
     assert d == pytest.approx(exact, abs=1e-9)
     assert world.ball_collides(centre.tolist(), ball) == bool(exact < 1e-6)
+    # at a tolerance: exactly as short as the search may stop, never more
+    world.cloud_tolerance = 0.5
+    (loose,) = world.body_distances(pose)
+    assert exact / 1.5 - 1e-9 <= loose <= exact + 1e-9
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(clouds(), st.floats(0.0, 0.3), st.floats(0.1, 2.0))
+def test_a_tolerance_keeps_the_padded_verdict_exact(case, padding, tolerance):
+    """The tolerance's floor is the threshold of the verdict (the padding): a state is in
+    collision exactly when some ball is within the padding, as with the exact search, and
+    a clearance past it is short by at most the factor 1 + tolerance."""
+    points, radius, axes, pose = case
+    world = _world(points, radius, axes, tolerance=tolerance)
+    world.padding = padding
+    brute = _coal_distances(points, radius, axes, pose).min()
+    if abs(brute - padding) < 1e-5:  # GJK's own tolerance decides it
+        return
+    assert world.in_collision(pose) == bool(brute < padding)
+    (clearance,) = world.safe_body_clearances(pose)
+    beyond = max(brute - padding, 0.0)
+    # coal's GJK (brute) may stop up to about 1e-6 of the distance above it
+    assert (beyond - 1e-5 * brute) / (1.0 + tolerance) - 2e-6 <= clearance
+    assert clearance <= beyond + 1e-6 * brute + 2e-6
 
 
 def test_bad_clouds_are_refused_with_a_message():
@@ -214,11 +248,19 @@ def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
     cloud = Obstacle(kind="pointcloud", index=0, spec={}, center=np.zeros(3), rotation=np.eye(3),
                      extents=np.full(3, radius), vertices=np.ascontiguousarray(points))  # fmt: skip
     kernel = ArmWorld(arm, [cloud], prove_pairs=False).kernel
+    tolerance = kernel.scene.cloud_tolerance  # as planners use it
+    loose, _ = kernel.safe_clearances(q.tolist())
+    kernel.scene.cloud_tolerance = 0.0
     scene, _ = kernel.safe_clearances(q.tolist())
-    # the cheaper bounds change the work, not the answers
+    # the cheaper bounds change the work, not the exact answers
     kernel.scene.set_cloud_bounds(dop=False, gjk_planes=False, centre_line=False)
     bare, _ = kernel.safe_clearances(q.tolist())
     np.testing.assert_allclose(bare, scene, rtol=1e-5, atol=2e-6)
+    # the tolerance's answers: below the exact ones, by at most its factor (the floor,
+    # the allowance's raw threshold, is below 1e-6 m)
+    assert tolerance > 0
+    assert (np.asarray(loose) <= np.asarray(scene) + 1e-12).all()
+    assert (np.asarray(loose) * (1 + tolerance) >= np.asarray(scene) * (1 - 1e-5) - 2e-6).all()
     for k, (body, frame) in enumerate(zip(arm.bodies, frames, strict=True)):
         local = (points - frame[:3, 3]) @ frame[:3, :3]  # the points in the link's frame
         exact = max(_hull_distances(body.hull.vertices, body.hull.triangles, local).min()

@@ -521,6 +521,23 @@ CASES.append(
 )
 
 
+TIMES = rf"{NUMBER} \| {NUMBER} \| {NUMBER}"  # solve, shortcuts, planning (ms)
+CASES.append(
+    Case(  # the cloud's distance exact and at a tolerance, and the primitives: all solve
+        "cloud_tolerance.py",
+        ("--problems", "table_pick:1", "--seeds", "1", "--tolerances", "0,0.25")
+        + ("--json", "{tmp}/tolerance.json"),
+        (
+            r"^\| setting \| solved \| solve ms \| shortcuts ms \| planning ms \| ",
+            rf"^\| cloud, tolerance 0 \| 1/1 \| {TIMES} \| \d+ \| \d+ \| 1\.00 \| ",
+            rf"^\| cloud, tolerance 0\.25 \| 1/1 \| {TIMES} \| \d+ \| \d+ \| ",
+            rf"^\| primitives \| 1/1 \| {TIMES} \| 0 \| 0 \| {NUMBER} \| 1\.00 \|$",
+        ),
+        ("tolerance.json",),
+    )
+)
+
+
 CASES.append(
     Case(  # the cloud tree's two orders: both build, both plan the same problem
         "cloud_tree_order.py",

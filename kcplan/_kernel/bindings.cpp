@@ -226,6 +226,10 @@ NB_MODULE(_core, m) {
           },
           "dop"_a = true, "gjk_planes"_a = true, "centre_line"_a = true,
           "Which cheaper bounds the clouds ask before GJK (point_cloud.hpp CloudBounds)")
+      .def_prop_rw("cloud_tolerance", &kcplan::World::cloud_tolerance,
+                   &kcplan::World::set_cloud_tolerance,
+                   "How far below its distance a cloud's answer may lie, relative, beyond the "
+                   "verdict's threshold (world.hpp; 0: exact)")
       .def("set_cloud_order", &kcplan::World::set_cloud_order, "order"_a,
            "Rebuild every cloud's tree in this order (an ablation: the answers stay the same)")
       .def_prop_ro("body_query_counts", [](const kcplan::World& w) { return w.body_query_counts; })

@@ -292,23 +292,27 @@ double PointCloud::exact(Query& q, std::size_t i, Vec3s& towards) {
   return d;
 }
 
-double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towards) {
+double PointCloud::search(Query& q, double cap, double stop_below, const DistanceTolerance& tol,
+                          Vec3s* towards) {
   ++counters.queries;
-  // a node's bound: the larger of the boxes' gap and the separation along the centres
+  // `best`: the nearest ball met (cap: none yet); `limit`: what a bound must stay under
+  // for its node or point to be looked at, tol.lower(best) (every bound at or past it
+  // leaves the answer, tol.lower(best), a lower bound; DistanceTolerance)
+  double best = cap, limit = cap;
   auto node_bound = [&](const Node& node) {
     ++counters.nodes;
-    return q.bound<false>(node.centre, node.half, best + radius_) - radius_;
+    return q.bound<false>(node.centre, node.half, limit + radius_) - radius_;
   };
   stack_.clear();
-  if (node_bound(nodes_[0]) < best) stack_.push_back(0);
+  if (node_bound(nodes_[0]) < limit) stack_.push_back(0);
   while (!stack_.empty()) {
     const Node& node = nodes_[stack_.back()];
     stack_.pop_back();
     if (node.left < 0) {
       for (std::uint32_t i = node.begin; i < node.end; ++i) {
         ++counters.points;
-        const double bound = q.bound<true>(points_[i], Vec3s::Zero(), best + radius_) - radius_;
-        if (bound >= best) continue;
+        const double bound = q.bound<true>(points_[i], Vec3s::Zero(), limit + radius_) - radius_;
+        if (bound >= limit) continue;
         Vec3s dir;
         double d;
         if (q.ball) {  // the bound is the distance, along the centres' line
@@ -321,6 +325,7 @@ double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towar
         }
         if (d < best) {
           best = d;
+          limit = tol.lower(d);
           if (towards != nullptr) *towards = dir;
         }
         if (best < stop_below) return best;
@@ -331,23 +336,26 @@ double PointCloud::search(Query& q, double best, double stop_below, Vec3s* towar
     // the nearer child is popped first: pushed last
     const std::int32_t near = a <= b ? node.left : node.left + 1;
     const double far_bound = a <= b ? b : a, near_bound = a <= b ? a : b;
-    if (far_bound < best) stack_.push_back(near == node.left ? node.left + 1 : node.left);
-    if (near_bound < best) stack_.push_back(near);
+    if (far_bound < limit) stack_.push_back(near == node.left ? node.left + 1 : node.left);
+    if (near_bound < limit) stack_.push_back(near);
   }
-  return best;
+  return best < cap ? limit : cap;
 }
 
 bool PointCloud::collides(const coal::CollisionObject& shape) {
   Query q(shape, *this);
   // a contact within GJK's tolerance counts (as collision_request() counts it)
   const double within = distance_request(false).gjk_tolerance;
-  return search(q, within, within, nullptr) < within;
+  return search(q, within, within, DistanceTolerance{}, nullptr) < within;
 }
 
-double PointCloud::distance(const coal::CollisionObject& shape, double cap, Vec3s* towards) {
+double PointCloud::distance(const coal::CollisionObject& shape, double cap, Vec3s* towards,
+                            const DistanceTolerance& tolerance) {
+  if (!(tolerance.relative >= 0.0) || !(tolerance.floor >= 0.0))
+    throw std::invalid_argument("cloud distance: expected a tolerance and a floor >= 0");
   Query q(shape, *this);
   if (towards != nullptr) towards->setZero();
-  return std::max(search(q, cap, std::numeric_limits<double>::min(), towards), 0.0);
+  return std::max(search(q, cap, std::numeric_limits<double>::min(), tolerance, towards), 0.0);
 }
 
 double PointCloud::support(const coal::AABB& region, const Vec3s& n) const {

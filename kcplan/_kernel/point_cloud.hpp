@@ -35,6 +35,27 @@ struct CloudBounds {
   bool centre_line = true;  ///< the support along the centres' line (not for hulls)
 };
 
+/// How far below the distance to a cloud its answer may lie: a search that stops early.
+///
+/// With g(x) = x for x <= floor and g(x) = floor + (1 + relative) (x - floor) beyond (g
+/// increasing, g(x) >= x), the search skips every node and point whose bound b has
+/// g(b) >= best, `best` the nearest ball met so far, and answers lower(best) = g^-1(best)
+/// (the cap when no ball nearer than it was met). The answer a is a lower bound of the
+/// true distance d: a point measured is at least best >= a away; a point skipped has
+/// d >= b >= g^-1(best then) >= a, since `best` only falls. Where d <= floor nothing at
+/// or below d is skipped (g(b) = b there), so a = d: a verdict at the floor (a clearance's
+/// threshold: contact, or the padding) is the exact search's. Beyond it, d - floor <=
+/// (1 + relative) (a - floor): a guard's clearance is at most that factor short.
+/// relative = 0 is the exact search.
+struct DistanceTolerance {
+  double relative = 0.0;  ///< >= 0
+  double floor = 0.0;     ///< metres, >= 0: exact at or below it
+  /// g^-1(found): the least distance a nearest ball met at `found` stands for.
+  double lower(double found) const {
+    return found <= floor ? found : floor + (found - floor) / (1.0 + relative);
+  }
+};
+
 /// How a cloud's tree orders its points before splitting them in halves.
 enum class CloudOrder {
   /// Sorted once along a Morton (Z-order) curve of 10 bits per axis (cubic cells, 1024 to
@@ -106,11 +127,12 @@ class PointCloud {
   /// Whether some ball touches `shape` (at its transform, its AABB computed).
   bool collides(const coal::CollisionObject& shape);
   /// min(cap, the distance from `shape` to the nearest ball), 0 on contact; as coal
-  /// measures it (see the class notes). `cap` = inf for the distance itself. With
-  /// `towards`, the unit direction from that ball's nearest point towards the shape's
-  /// (zero when no ball is nearer than the cap, or on contact).
+  /// measures it (see the class notes), and as far below it as `tolerance` allows (exact
+  /// by default; std::invalid_argument for a negative one). `cap` = inf for the distance
+  /// itself. With `towards`, the unit direction from that ball's nearest point towards
+  /// the shape's (zero when no ball is nearer than the cap, or on contact).
   double distance(const coal::CollisionObject& shape, double cap,
-                  coal::Vec3s* towards = nullptr);
+                  coal::Vec3s* towards = nullptr, const DistanceTolerance& tolerance = {});
   /// The support of the balls that meet `region` along `n`: the largest n . y over every
   /// point y of those balls (-inf if none). Every ball meeting the region lies in
   /// {x : n . x <= support}: a plane of the points near a body, for region certificates
@@ -146,9 +168,11 @@ class PointCloud {
   /// GJK's distance from the query shape to the ball about point i (<= 0: contact).
   /// `towards` gets GJK's unit direction from the ball to the shape (zero if none).
   double exact(Query& q, std::size_t i, coal::Vec3s& towards);
-  /// min(best, the distance to the nearest ball), depth first, the nearer child first;
-  /// returns as soon as a ball nearer than `stop_below` is found.
-  double search(Query& q, double best, double stop_below, coal::Vec3s* towards);
+  /// min(cap, the distance to the nearest ball) within `tolerance` (DistanceTolerance),
+  /// depth first, the nearer child first; returns that ball's distance as soon as it is
+  /// below `stop_below`.
+  double search(Query& q, double cap, double stop_below, const DistanceTolerance& tolerance,
+                coal::Vec3s* towards);
 
   std::vector<coal::Vec3s> points_;
   std::vector<Node> nodes_;

@@ -502,7 +502,8 @@ bool World::collides(coal::CollisionObject& object, std::size_t shape) {
 double World::pair_distance(coal::CollisionObject& object, std::size_t shape,
                             coal::CollisionObject& obstacle, coal::DistanceRequest& request,
                             coal::DistanceResult& result, double cap) {
-  if (PointCloud* cloud = cloud_of(obstacle)) return cloud->distance(object, cap);
+  if (PointCloud* cloud = cloud_of(obstacle))
+    return cloud->distance(object, cap, nullptr, cloud_search(shape));
   if (const auto bound = plane_bound(object, obstacle, true);
       bound && bound->value > 0.0 && bound->exact)
     return bound->value;
@@ -705,7 +706,7 @@ bool World::body_region(std::size_t k, double horizon, FreeRegion& region, bool 
       // measured up to the horizon only; its plane holds the balls that meet the
       // horizon's box (every other ball is farther than the horizon)
       Vec3s towards;
-      const double d = cloud->distance(body, raw_cap(horizon, k), &towards);
+      const double d = cloud->distance(body, raw_cap(horizon, k), &towards, cloud_search(k));
       if (!(d > 0.0) || (pad > 0.0 && !(clear(d, k) > 0.0))) {
         region.planes.clear(), region.horizon = 0.0;
         return false;
