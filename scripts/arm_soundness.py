@@ -244,7 +244,11 @@ def study(args: argparse.Namespace, out=sys.stderr) -> dict:
             t = time.perf_counter()
             planned, checked, counts = scene_obstacles(problem, j, args)
             world = ArmWorld(arm, planned, allowed=problem.allowed)
-            kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation, planes=args.planes)
+            if args.cloud_tolerance is not None:
+                world.kernel.scene.cloud_tolerance = args.cloud_tolerance
+            c["cloud_tolerance"] = world.kernel.scene.cloud_tolerance
+            kernel = KernelArmCertifier(world, kc_inflation=args.kc_inflation, planes=args.planes,
+                                        probes=args.probes)  # fmt: skip
             meshes = _Meshes(arm, checked, problem.allowed)
             touch = None
             if args.graze:  # the same obstacles, no self pair: graze the obstacles
@@ -466,6 +470,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="the KC guards' inflation (0: the clearance balls alone)")  # fmt: skip
     parser.add_argument("--no-planes", dest="planes", action="store_false",
                         help="certify without the free-region planes (the ablation)")  # fmt: skip
+    parser.add_argument("--no-probes", dest="probes", action="store_false",
+                        help="certify without the probes, which only reject early: the "
+                        "lazy compiled planner's check of its path's edges")  # fmt: skip
+    parser.add_argument("--cloud-tolerance", type=float, default=None, metavar="T",
+                        help="with --cloud: the kernel's relative tolerance of a cloud's "
+                        "distances (World.cloud_tolerance; default the kernel's)")  # fmt: skip
     parser.add_argument("--cloud", type=int, default=0, metavar="N",
                         help="replace each problem's obstacles by N surface points of each "
                         "(0: the primitives)")  # fmt: skip
@@ -493,6 +503,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         parser.error("expected --cloud >= 0 and --spacing >= 0")
     if not (math.isfinite(args.point_radius) and args.point_radius > 0.0):
         parser.error("expected --point-radius > 0")
+    if args.cloud_tolerance is not None and not (
+        math.isfinite(args.cloud_tolerance) and args.cloud_tolerance >= 0.0
+    ):
+        parser.error("expected --cloud-tolerance >= 0")
     if (args.spacing > 0 or args.balls) and not args.cloud:
         parser.error("--spacing and --balls are about a cloud: give --cloud N too")
     if args.bodies is None and args.max_offset is None and args.representation != "hulls":
@@ -532,6 +546,7 @@ def main(argv: list[str] | None = None) -> int:
         f"seed {args.seed}; KC inflation {args.kc_inflation}: {c['grown_queries']} KC guards "
         f"asked, {c['kc_reaches']} took a body farther than its ball"
         + (f"; planes: {c['plane_reaches']} took a body farther" if args.planes else "; no planes")
+        + ("" if args.probes else "; no probes (the lazy compiled planner's path check)")
     )
     if args.graze:
         print(f"- grazing (--graze {args.graze:g}): {c['grazing']} edges cut short to end near "
@@ -574,7 +589,8 @@ def _cloud_table(args: argparse.Namespace, c: dict, low: dict) -> None:
     print(f"- {args.cloud:,} surface points per object, seed {args.seed}; every accepted edge "
           f"re-checked on the links' meshes against every original point as a ball of "
           f"{args.point_radius:g} m ({how}); scenes built in {c['scene_s']:.0f} s "
-          f"({c['scene_s'] / max(c['scenes'], 1):.1f} s each)")  # fmt: skip
+          f"({c['scene_s'] / max(c['scenes'], 1):.1f} s each); the kernel's cloud distances "
+          f"within a relative tolerance of {c['cloud_tolerance']:g}")  # fmt: skip
 
 
 if __name__ == "__main__":
