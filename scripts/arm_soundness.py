@@ -507,8 +507,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         math.isfinite(args.cloud_tolerance) and args.cloud_tolerance >= 0.0
     ):
         parser.error("expected --cloud-tolerance >= 0")
-    if (args.spacing > 0 or args.balls) and not args.cloud:
-        parser.error("--spacing and --balls are about a cloud: give --cloud N too")
+    if (args.spacing > 0 or args.balls or args.cloud_tolerance is not None) and not args.cloud:
+        parser.error("--spacing, --balls and --cloud-tolerance are about a cloud: give "
+                     "--cloud N too")  # fmt: skip
     if args.bodies is None and args.max_offset is None and args.representation != "hulls":
         args.bodies = 2
     if args.edges < 1 or args.per_class < 1 or not 0.0 <= args.free_check <= 1.0:
