@@ -338,8 +338,9 @@ def test_an_mbm_request_that_moves_the_base_imports_and_plans(tmp_path, capsys):
 
 def test_pair_proofs_are_cached_on_disk_for_the_arm_as_the_kernel_reads_it(tmp_path, monkeypatch):
     """A PR2's 1,044 pairs take seconds to prove: the proofs are kept per machine, keyed by
-    everything the kernel reads; a new process reads them back alike, and an arm with
-    other limits is proven anew."""
+    everything the kernel reads; the same robot loaded again finds them in memory, a new
+    process reads them back alike, and an arm with other limits is proven anew."""
+    from kcplan._kernel import arm_digest, kernel_chain
     from kcplan.arm import pairs as pairs_module
 
     monkeypatch.setenv("KCPLAN_CACHE_DIR", str(tmp_path))
@@ -354,10 +355,17 @@ def test_pair_proofs_are_cached_on_disk_for_the_arm_as_the_kernel_reads_it(tmp_p
     first = pairs_module.prove_pairs(arm)
     assert [p.verdict for p in first] == ["touches"]  # d folds back onto a
     assert len(list((tmp_path / "pairs").glob("*.npz"))) == 1
-    calls = []
+    calls, reads, read = [], [], pairs_module._read
     monkeypatch.setattr(pairs_module, "_write", lambda *a: calls.append(a))
-    again = pairs_module.prove_pairs(load_arm(urdf, ["spin", "bend"]))  # from disk
-    assert again == first and not calls
+    monkeypatch.setattr(pairs_module, "_read", lambda *a: reads.append(a) or read(*a))
+    # the same robot loaded again in this process: one arm to the kernel, from memory
+    reloaded = load_arm(urdf, ["spin", "bend"])
+    assert reloaded is not arm and arm_digest(reloaded) == arm_digest(arm)
+    assert kernel_chain(reloaded) is kernel_chain(arm)
+    assert pairs_module.prove_pairs(reloaded) == first and not reads and not calls
+    monkeypatch.setattr(pairs_module, "_PROOFS", {})  # a new process: from disk
+    again = pairs_module.prove_pairs(load_arm(urdf, ["spin", "bend"]))
+    assert again == first and len(reads) == 1 and not calls
     narrow = urdf.read_text().replace('lower="-3.14" upper="3.14"', 'lower="-0.5" upper="0.5"')
     (tmp_path / "narrow.urdf").write_text(narrow)
     other = pairs_module.prove_pairs(load_arm(tmp_path / "narrow.urdf", ["spin", "bend"]))

@@ -87,6 +87,7 @@ __all__ = [
     "DiscreteArmMotions",
     "ScreenedArmMotions",
     "add_obstacles",
+    "arm_digest",
     "build_kernel_arm",
     "build_kernel_world",
     "kernel_chain",
@@ -197,7 +198,10 @@ def add_obstacles(world: _core.World, obstacles, n: int) -> None:
             raise ValueError(f"{ob.label}: unknown obstacle kind {ob.kind!r}")
 
 
-_CHAINS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_CHAINS: dict[str, _core.Chain] = {}
+_MOST_CHAINS = 16
+"""Chains kept by :func:`kernel_chain` (the oldest is let go first): a Panda's is 0.3 MB."""
 
 
 @functools.lru_cache(maxsize=1)
@@ -208,18 +212,52 @@ def kernel_digest() -> str:
     return hashlib.sha256(Path(_core.__file__).read_bytes()).hexdigest()
 
 
+def arm_digest(arm) -> str:
+    """A digest of an :class:`kcplan.arm.ArmModel` as the kernel reads it (what
+    :func:`kernel_chain` reads: joints, placements, axes, kinds, limits, wrapping, bodies
+    and hulls) and of the kernel itself (:func:`kernel_digest`).
+
+    Two arms of one digest are one arm to the kernel, so what it made of one serves the
+    other: its chain (:func:`kernel_chain`) and its self pairs' proofs
+    (:mod:`kcplan.arm.pairs`). A scenario read again (each MotionBenchMaker problem is
+    its own scenario) loads a new arm of the same robot, and the chain and the proofs
+    cost 3.5 ms of its first plan (RESULTS 36.1). Computed once per arm object (0.5 ms
+    for the Panda)."""
+    digest = _DIGESTS.get(arm)
+    if digest is None:
+        model = arm.model
+        h = hashlib.sha256(kernel_digest().encode())
+        h.update(repr((arm.kinds, arm.joints, list(model.parents))).encode())
+        for array in (arm.lower, arm.upper, arm.q_index,
+                      np.zeros(0) if arm.wraps is None else arm.wraps):  # fmt: skip
+            h.update(np.ascontiguousarray(array).tobytes())
+        for i in range(1, model.njoints):
+            h.update(np.asarray(model.jointPlacements[i].homogeneous, dtype=float).tobytes())
+        h.update(np.asarray(arm.joint_axes(), dtype=float).tobytes())
+        for body in arm.bodies:
+            h.update(repr(body.joint).encode() + body.placement.tobytes())
+            h.update(body.semi_axes.tobytes())
+            if body.hull is not None:
+                h.update(body.hull.vertices.tobytes() + body.hull.triangles.tobytes())
+        digest = _DIGESTS[arm] = h.hexdigest()
+    return digest
+
+
 def kernel_chain(arm) -> _core.Chain:
     """The kernel's twin of an :class:`kcplan.arm.ArmModel`'s chain and bodies: the
     reduced model's joint placements, axes and kinds (``arm.joint_axes()``), each joint's
     place in the state, the limits and the bodies (a hull's vertices and triangles with
     it). The kernel imports nothing of kcplan's above it: the arm is read, not imported.
 
-    Made once per arm (an arm is immutable, and a :class:`Chain` is an immutable
-    description that each kernel world copies, sharing its hulls): building the hulls'
-    coal geometry again cost 2.4 ms of every Panda plan."""
-    chain = _CHAINS.get(arm)
+    Made once per arm as the kernel reads it (:func:`arm_digest`; a :class:`Chain` is an
+    immutable description that each kernel world copies, sharing its hulls): building
+    the hulls' coal geometry again cost 2.4 ms of every Panda plan."""
+    digest = arm_digest(arm)
+    chain = _CHAINS.get(digest)
     if chain is None:
-        chain = _CHAINS[arm] = _build_chain(arm)
+        if len(_CHAINS) >= _MOST_CHAINS:
+            del _CHAINS[next(iter(_CHAINS))]
+        chain = _CHAINS[digest] = _build_chain(arm)
     return chain
 
 

@@ -11,10 +11,11 @@ touches. A pair proven apart is never checked again (:class:`kcplan.arm.ArmWorld
 that touches, or whose proof ran out of boxes, is checked as before.
 
 The proofs depend on the arm alone (bodies, joints, limits), so they are computed once
-per :class:`kcplan.arm.ArmModel` and kept with it for the process's life, and on disk in
-the per-user cache (:func:`kcplan.cover.cache.cache_folder`, subfolder ``pairs``), keyed
-by everything the kernel reads of the arm, the pairs, the budget and a digest of the
-compiled kernel itself: a robot of thousands of pairs (a PR2's 1,044 take 5 s, a TIAGo
+per robot and kept for the process's life (by :func:`kcplan._kernel.arm_digest`: an arm
+loaded again from the same files finds them), and on disk in the per-user cache
+(:func:`kcplan.cover.cache.cache_folder`, subfolder ``pairs``), keyed by everything the
+kernel reads of the arm, the pairs, the budget and a digest of the compiled kernel
+itself: a robot of thousands of pairs (a PR2's 1,044 take 5 s, a TIAGo
 dual's 6,877 45 s on one core) pays once per machine, not once per ``kcplan plan``; and
 from :data:`PARALLEL_PAIRS` pairs on they are proven on every core.
 """
@@ -23,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import weakref
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -40,7 +40,9 @@ MAX_BOXES = 4000
 """Box centres measured per pair before its proof gives up (``unknown``): about 70 ms of
 the Panda's hulls per pair; the MBM Panda's 21 checked pairs take 0.04 s in all."""
 
-_PROOFS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_PROOFS: dict[str, dict] = {}
+"""The proofs made in this process, by arm (:func:`kcplan._kernel.arm_digest`), pair and
+budget."""
 
 
 @dataclass(frozen=True)
@@ -79,10 +81,10 @@ def prove_pairs(
     """The proof of each body pair of ``pairs`` ``(m, 2)`` (default: every self pair of
     ``arm``, :attr:`ArmModel.self_pairs`), computed once per arm and budget (module
     docstring) and then remembered."""
-    from kcplan._kernel import _core, kernel_chain
+    from kcplan._kernel import _core, arm_digest, kernel_chain
 
     pairs = np.asarray(arm.self_pairs if pairs is None else pairs, dtype=np.int64).reshape(-1, 2)
-    known = _PROOFS.setdefault(arm, {})
+    known = _PROOFS.setdefault(arm_digest(arm), {})
     todo = [(int(i), int(j)) for i, j in pairs if (int(i), int(j), max_boxes) not in known]
     if todo:
         chain = kernel_chain(arm)
@@ -123,23 +125,12 @@ def _prove(core, chain, pairs: list[tuple[int, int]], max_boxes: int) -> list:
 
 def _cache_path(arm: ArmModel, pairs: list[tuple[int, int]], max_boxes: int) -> Path:
     """Where the proofs of ``pairs`` are cached: a digest of the arm as the kernel reads it
-    (:func:`kcplan._kernel.kernel_chain`'s inputs), the pairs, the budget and the kernel."""
-    from kcplan._kernel import kernel_digest
+    and of the kernel (:func:`kcplan._kernel.arm_digest`), the pairs and the budget."""
+    from kcplan._kernel import arm_digest
     from kcplan.cover.cache import cache_folder
 
-    model = arm.model
-    h = hashlib.sha256(kernel_digest().encode())
-    h.update(repr((max_boxes, arm.kinds, arm.joints, list(model.parents))).encode())
-    for array in (arm.lower, arm.upper, arm.q_index, np.asarray(pairs, dtype=np.int64),
-                  np.zeros(0) if arm.wraps is None else arm.wraps):  # fmt: skip
-        h.update(np.ascontiguousarray(array).tobytes())
-    for i in range(1, model.njoints):
-        h.update(np.asarray(model.jointPlacements[i].homogeneous, dtype=float).tobytes())
-    h.update(np.asarray(arm.joint_axes(), dtype=float).tobytes())
-    for body in arm.bodies:
-        h.update(repr(body.joint).encode() + body.placement.tobytes() + body.semi_axes.tobytes())
-        if body.hull is not None:
-            h.update(body.hull.vertices.tobytes() + body.hull.triangles.tobytes())
+    h = hashlib.sha256(arm_digest(arm).encode())
+    h.update(repr(max_boxes).encode() + np.asarray(pairs, dtype=np.int64).tobytes())
     return cache_folder() / "pairs" / f"{h.hexdigest()}.npz"
 
 
