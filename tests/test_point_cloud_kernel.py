@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from kcplan._kernel import COAL_CLEARANCE_RTOL, CloudOrder
+from kcplan._kernel import COAL_CLEARANCE_RTOL, REACH_MARGIN, CloudOrder
 from kcplan._kernel import Robot as KernelRobot
 from kcplan._kernel import World as KernelWorld
 
@@ -261,6 +261,10 @@ def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
     assert tolerance > 0
     assert (np.asarray(loose) <= np.asarray(scene) + 1e-12).all()
     assert (np.asarray(loose) * (1 + tolerance) >= np.asarray(scene) * (1 - 1e-5) - 2e-6).all()
+    # the kernel's cloud keeps the points within the arm's reach (REACH_MARGIN beyond)
+    centre, reach = ArmWorld(arm, (), prove_pairs=False).reach
+    points = points[np.linalg.norm(points - centre, axis=1) <= reach + radius + REACH_MARGIN]
+    assert kernel.scene.cloud_points == len(points)
     for k, (body, frame) in enumerate(zip(arm.bodies, frames, strict=True)):
         local = (points - frame[:3, 3]) @ frame[:3, :3]  # the points in the link's frame
         exact = max(_hull_distances(body.hull.vertices, body.hull.triangles, local).min()
@@ -268,3 +272,51 @@ def test_a_link_hulls_clearance_to_a_cloud_is_every_points(panda, seed, radius):
         # certain (no more than the distance), and within coal's allowance of it
         assert scene[k] <= exact + 1e-9, (k, scene[k], exact)
         assert scene[k] >= exact * (1 - 2 * COAL_CLEARANCE_RTOL) - 1e-4, (k, scene[k], exact)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1))
+def test_a_cloud_keeps_the_points_within_the_arms_reach_and_its_verdicts(panda, seed):
+    """Points whose balls lie beyond the arm's reach ball are dropped (RESULTS 36.2): the
+    reach ball holds every hull vertex at random states, and every state's verdict is
+    that of the whole cloud."""
+    from kcplan.arm.kinematics import body_frames
+    from kcplan.arm.world import ArmWorld
+    from kcplan.world.obstacles import Obstacle
+
+    arm, rng, radius = panda, np.random.default_rng(seed), 0.01
+    centre, reach = ArmWorld(arm, (), prove_pairs=False).reach
+    states = rng.uniform(arm.lower, arm.upper, size=(40, arm.dof))
+    for q in states:
+        for body, frame in zip(arm.bodies, body_frames(arm, q), strict=True):
+            world = body.hull.vertices @ frame[:3, :3].T + frame[:3, 3]
+            assert np.linalg.norm(world - centre, axis=1).max() <= reach
+    # a shell of points about the reach's edge, and some at the links
+    directions = rng.normal(size=(600, 3))
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    points = centre + directions * rng.uniform(0.2, 1.5 * reach, size=(600, 1))
+    cloud = Obstacle(kind="pointcloud", index=0, spec={}, center=np.zeros(3), rotation=np.eye(3),
+                     extents=np.full(3, radius), vertices=np.ascontiguousarray(points))  # fmt: skip
+    kernel = ArmWorld(arm, [cloud], prove_pairs=False).kernel
+    within = np.linalg.norm(points - centre, axis=1) <= reach + radius + REACH_MARGIN
+    assert kernel.scene.cloud_points == within.sum() < len(points)
+    whole = ArmWorld(arm, [cloud], prove_pairs=False)
+    whole.__dict__["reach"] = (centre, np.inf)  # the ablation: every point kept
+    every = whole.kernel
+    assert every.scene.cloud_points == len(points)
+    for q in states:
+        assert kernel.in_collision(q.tolist()) == every.in_collision(q.tolist())
+
+
+def test_a_reach_is_set_before_the_obstacles_and_a_cloud_beyond_it_is_no_obstacle():
+    world = KernelWorld(KernelRobot(3, [0.1, 0.1, 0.1], [0, 0, 0, 0, 0, 0, 1]), 1.0, 0, 0)
+    world.set_reach([0.0, 0.0, 0.0], 1.0)
+    world.add_points(np.array([[3.0, 0.0, 0.0], [0.0, 4.0, 0.0]]), 0.01)
+    assert world.n_objects == 0 and world.cloud_points == 0
+    world.add_points(np.array([[0.5, 0.0, 0.0], [0.0, 4.0, 0.0]]), 0.01)
+    assert world.n_objects == 1 and world.cloud_points == 1
+    with pytest.raises(ValueError, match="reach: expected before the first obstacle"):
+        world.set_reach([0.0, 0.0, 0.0], 2.0)
+    with pytest.raises(ValueError, match="reach: expected a finite centre and a radius > 0"):
+        KernelWorld(KernelRobot(3, [0.1] * 3, [0, 0, 0, 0, 0, 0, 1]), 1.0, 0, 0).set_reach(
+            [0.0, 0.0, 0.0], -1.0)

@@ -3,16 +3,18 @@ one process: what `perf record` samples in RESULTS 34.2 (run.sh). Prints the med
 whole call, the solve, the shortcuts and the rest (the world's build).
 
     python benchmarks/profile/plan_loop.py [--prims] [--seeds N] [--problems CLASS:I,...]
-        [--fresh [--forget]]
+        [--fresh [--forget]] [--no-reach]
 
 ``--fresh`` reads each problem's scenario again before each plan, so that each plan has
 an arm of its own, as ``scripts/cloud_mbm.py``'s problems do; ``--forget`` then empties
 the kernel's chains and the pairs' proofs kept in memory before each plan, as each new
-arm found them before RESULTS 36.1 (the ablation of those caches).
+arm found them before RESULTS 36.1 (the ablation of those caches). ``--no-reach`` keeps
+every point of a cloud, those beyond the arm's reach too (the ablation of RESULTS 36.2).
 """
 
 import argparse
 import dataclasses
+import math
 import os
 import statistics
 import sys
@@ -25,6 +27,7 @@ import cloud_mbm  # noqa: E402  (the clouds exactly as RESULTS 30 samples them)
 from kcplan import _kernel, plan  # noqa: E402
 from kcplan.arm import pairs  # noqa: E402
 from kcplan.arm.mbm import load_mbm_archive  # noqa: E402
+from kcplan.arm.world import ArmWorld  # noqa: E402
 
 PROBLEMS = ",".join(f"{c}:{i}" for c in cloud_mbm.CLASSES for i in (1, 3))
 
@@ -35,7 +38,11 @@ parser.add_argument("--prims", action="store_true", help="plan on the primitives
 parser.add_argument("--planner", default="kc-rrtconnect-lazy-native")
 parser.add_argument("--fresh", action="store_true", help="each plan on a scenario read anew")
 parser.add_argument("--forget", action="store_true", help="each plan without the arm caches")
+parser.add_argument("--no-reach", action="store_true",
+                    help="clouds keep the points beyond the arm's reach (the ablation)")
 args = parser.parse_args()
+if args.no_reach:  # a ball of infinite radius: every point kept, as before RESULTS 36.2
+    ArmWorld.reach = property(lambda self: ([0.0, 0.0, 0.0], math.inf))
 keys = [(c, int(i)) for c, i in (s.split(":") for s in args.problems.split(","))]
 mbm = load_mbm_archive(os.fspath(cloud_mbm.MBM / "panda" / "problems.tar.bz2"), keys)
 

@@ -162,6 +162,12 @@ NB_MODULE(_core, m) {
             w.add_points(points.data(), points.shape(0), radius, order);
           },
           "points"_a, "radius"_a, "order"_a = kcplan::CloudOrder::morton)
+      .def("set_reach", &kcplan::World::set_reach, "centre"_a, "radius"_a,
+           "A ball (metres) that holds every body at every state, padding included: the "
+           "clouds added after it keep only the points whose balls meet it")
+      .def_prop_ro("reach_radius", [](const kcplan::World& w) { return w.reach().radius; })
+      .def_prop_ro("cloud_points", [](const kcplan::World& w) { return w.cloud_points(); },
+                   "Points every cloud kept (those within reach)")
       .def("finalize", &kcplan::World::finalize)
       .def_prop_rw("padding", &kcplan::World::padding, &kcplan::World::set_padding,
                    "Metres every body keeps from every obstacle (MoveIt's link padding)")

@@ -44,23 +44,26 @@ std::uint64_t spread_bits(std::uint32_t v) {
   return x;
 }
 
-/// The n points `xyz` (n x 3) sorted along a Morton curve: per point a key, its 30-bit
-/// code in bits 32-61 (cubic cells, 1024 to the longest side of the box lo-hi that holds
-/// them) and its index below, the keys in the code's order (ties in the index's).
-std::vector<std::uint64_t> morton_keys(const double* xyz, std::size_t n, const Vec3s& lo,
-                                       const Vec3s& hi) {
+/// The `kept` points of the n points `xyz` (n x 3) that `skip` (empty: none) does not
+/// mark, sorted along a Morton curve: per point a key, its 30-bit code in bits 32-61
+/// (cubic cells, 1024 to the longest side of the box lo-hi that holds them) and its index
+/// in `xyz` below, the keys in the code's order (ties in the index's).
+std::vector<std::uint64_t> morton_keys(const double* xyz, std::size_t n, std::size_t kept,
+                                       const Vec3s& lo, const Vec3s& hi,
+                                       const std::vector<bool>& skip) {
   const double side = (hi - lo).maxCoeff();
   const double scale = side > 0.0 ? 1023.0 / side : 0.0;
   auto cell = [scale](double v) {
     return static_cast<std::uint32_t>(std::clamp(v * scale, 0.0, 1023.0));
   };
-  std::vector<std::uint64_t> keys(n), sorted(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::uint64_t> keys(kept), sorted(kept);
+  for (std::size_t i = 0, k = 0; i < n; ++i) {
+    if (!skip.empty() && skip[i]) continue;
     const double* p = xyz + 3 * i;
     const std::uint64_t code = spread_bits(cell(p[0] - lo[0])) |
                                spread_bits(cell(p[1] - lo[1])) << 1 |
                                spread_bits(cell(p[2] - lo[2])) << 2;
-    keys[i] = code << 32 | i;
+    keys[k++] = code << 32 | i;
   }
   // least significant digit first, 10 bits a pass: 3 passes, each stable
   for (int shift = 32; shift < 62; shift += 10) {
@@ -178,34 +181,46 @@ struct PointCloud::Query {
 };
 
 PointCloud::PointCloud(const double* xyz, std::size_t n, double radius, CloudOrder order,
-                       std::size_t leaf_size)
+                       std::size_t leaf_size, const CloudReach& reach)
     : radius_(radius) {
   if (n == 0) throw std::invalid_argument("point cloud: expected at least one point");
   if (n >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("point cloud: too many points");
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw std::invalid_argument("point cloud: expected a finite radius > 0");
+  if (!(reach.radius > 0.0) || !reach.centre.allFinite())
+    throw std::invalid_argument("point cloud: expected a reach of radius > 0");
   if (leaf_size == 0) leaf_size = 1;
   Vec3s lo = Vec3s::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<bool> skip;  // the points beyond reach (none: empty)
+  std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Map<const Vec3s> p(xyz + 3 * i);
     if (!p.allFinite()) throw std::invalid_argument("point cloud: expected finite coordinates");
+    if (std::isfinite(reach.radius) && !reachable(p, radius, reach)) {
+      if (skip.empty()) skip.assign(n, false);
+      skip[i] = true;
+      continue;
+    }
+    ++kept;
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  if (kept == 0) throw std::invalid_argument("point cloud: expected a point within reach");
   // a split leaves at least one point on each side: at most 2 n - 1 nodes
-  nodes_.reserve(order == CloudOrder::median ? 4 * (n / leaf_size + 1) : 2 * n);
+  nodes_.reserve(order == CloudOrder::median ? 4 * (kept / leaf_size + 1) : 2 * kept);
   nodes_.resize(1);
-  points_.resize(n);
+  points_.resize(kept);
   if (order == CloudOrder::median) {
-    for (std::size_t i = 0; i < n; ++i) points_[i] = Eigen::Map<const Vec3s>(xyz + 3 * i);
-    build_median(0, 0, static_cast<std::uint32_t>(n), leaf_size);
+    for (std::size_t i = 0, k = 0; i < n; ++i)
+      if (skip.empty() || !skip[i]) points_[k++] = Eigen::Map<const Vec3s>(xyz + 3 * i);
+    build_median(0, 0, static_cast<std::uint32_t>(kept), leaf_size);
   } else {  // the points copied once, in the curve's order
-    const std::vector<std::uint64_t> keys = morton_keys(xyz, n, lo, hi);
-    for (std::size_t i = 0; i < n; ++i)
+    const std::vector<std::uint64_t> keys = morton_keys(xyz, n, kept, lo, hi, skip);
+    for (std::size_t i = 0; i < kept; ++i)
       points_[i] = Eigen::Map<const Vec3s>(xyz + 3 * (keys[i] & 0xffffffffu));
     Vec3s node_lo, node_hi;
-    build_cells(0, 0, static_cast<std::uint32_t>(n), keys, leaf_size, node_lo, node_hi);
+    build_cells(0, 0, static_cast<std::uint32_t>(kept), keys, leaf_size, node_lo, node_hi);
   }
   const Node& root = nodes_[0];
   const Vec3s grow = root.half + Vec3s::Constant(radius_);

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <array>
+#include <limits>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -54,6 +55,17 @@ struct DistanceTolerance {
   double lower(double found) const {
     return found <= floor ? found : floor + (found - floor) / (1.0 + relative);
   }
+};
+
+/// A ball that holds the robot at every state (kcplan.arm.bounds.reach_ball): a point
+/// whose ball lies beyond it is never met by a body, so a cloud keeps none of them. Every
+/// answer of the cloud is then one about the points the robot can reach: a verdict is
+/// unchanged at every state, and a distance is a lower bound of the distance to the balls
+/// it keeps (a guard ball free of them is free of every ball where the robot can be).
+/// The whole space by default.
+struct CloudReach {
+  coal::Vec3s centre = coal::Vec3s::Zero();
+  double radius = std::numeric_limits<double>::infinity();  ///< metres, > 0
 };
 
 /// How a cloud's tree orders its points before splitting them in halves.
@@ -108,13 +120,21 @@ enum class CloudOrder {
 /// GJK.
 ///
 /// Contract: at least one point, every coordinate finite, radius > 0 and finite
-/// (std::invalid_argument otherwise). Immutable once built, except its counters and GJK
+/// (std::invalid_argument otherwise); at least one point within `reach` grown by the
+/// radius (CloudReach; the World adds no cloud that has none). Immutable once built, except its counters and GJK
 /// scratch: not thread-safe.
 class PointCloud {
  public:
   /// `xyz`: n x 3 row-major coordinates (world frame).
   PointCloud(const double* xyz, std::size_t n, double radius,
-             CloudOrder order = CloudOrder::morton, std::size_t leaf_size = 8);
+             CloudOrder order = CloudOrder::morton, std::size_t leaf_size = 8,
+             const CloudReach& reach = {});
+
+  /// Whether point `p`'s ball of `radius` meets the ball `reach`.
+  static bool reachable(const coal::Vec3s& p, double radius, const CloudReach& reach) {
+    const double r = reach.radius + radius;
+    return (p - reach.centre).squaredNorm() <= r * r;
+  }
 
   std::size_t size() const { return points_.size(); }
   double radius() const { return radius_; }

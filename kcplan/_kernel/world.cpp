@@ -387,13 +387,27 @@ void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>
 
 void World::add_points(const double* xyz, std::size_t n, double radius, CloudOrder order) {
   if (dimension_ != 3) throw std::invalid_argument("point cloud: a 3D obstacle");
-  auto cloud = std::make_unique<PointCloud>(xyz, n, radius, order);
+  if (n > 0 && std::isfinite(reach_.radius)) {  // no obstacle when nothing is within reach
+    bool any = false;
+    for (std::size_t i = 0; i < n && !any; ++i)
+      any = PointCloud::reachable(Eigen::Map<const Vec3s>(xyz + 3 * i), radius, reach_);
+    if (!any && std::isfinite(radius) && radius > 0.0) return;
+  }
+  auto cloud = std::make_unique<PointCloud>(xyz, n, radius, order, 8, reach_);
   // the broad phase sees the cloud's box; its narrow phase is the cloud's own
   const coal::AABB& box = cloud->bounds();
   const Vec3s side = box.max_ - box.min_;
   add(std::make_shared<coal::Box>(side[0], side[1], side[2]),
       coal::Transform3s(coal::Matrix3s::Identity(), box.center()), Support{});
   clouds_.back() = std::move(cloud);
+}
+
+void World::set_reach(const std::array<double, 3>& centre, double radius) {
+  if (!(radius > 0.0) || !std::isfinite(centre[0]) || !std::isfinite(centre[1]) ||
+      !std::isfinite(centre[2]))
+    throw std::invalid_argument("reach: expected a finite centre and a radius > 0");
+  if (!clouds_.empty()) throw std::invalid_argument("reach: expected before the first obstacle");
+  reach_ = CloudReach{Vec3s(centre[0], centre[1], centre[2]), radius};
 }
 
 void World::set_cloud_order(CloudOrder order) {

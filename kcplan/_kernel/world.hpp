@@ -225,6 +225,19 @@ class World {
   }
   /// Rebuild every cloud's tree in `order` (for ablations: the answers stay the same).
   void set_cloud_order(CloudOrder order);
+  /// A ball (metres) that holds every body at every state, padding included: the clouds
+  /// added after it keep only the points whose balls meet it, and a cloud with none is
+  /// not added (CloudReach: the verdicts at every state stay those of every point).
+  /// Before the first obstacle (std::invalid_argument otherwise); none by default.
+  void set_reach(const std::array<double, 3>& centre, double radius);
+  const CloudReach& reach() const { return reach_; }
+  /// Points kept by every cloud.
+  std::size_t cloud_points() const {
+    std::size_t n = 0;
+    for (const auto& cloud : clouds_)
+      if (cloud) n += cloud->size();
+    return n;
+  }
   /// How far below its distance a cloud's answer may lie beyond a shape's threshold
   /// (DistanceTolerance::relative, its floor raw_cap(0, shape): the verdict "clear beyond
   /// the padding" stays exact, and a clearance c past it is at least c / (1 + tolerance)).
@@ -324,6 +337,7 @@ class World {
   double half_height_, rtol_, atol_;
   double padding_ = 0.0;
   double cloud_tolerance_ = 0.25;
+  CloudReach reach_;
   std::vector<double> body_padding_;  // per body; empty: padding_ for every one
   double max_padding_ = 0.0;          // the largest of body_padding_
   std::vector<std::unique_ptr<coal::CollisionObject>> objects_;

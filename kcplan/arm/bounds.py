@@ -107,6 +107,7 @@ __all__ = [
     "chain_speeds",
     "pair_speeds",
     "point_speeds",
+    "reach_ball",
     "relative_accelerations",
     "relative_first_order",
     "relative_speeds",
@@ -167,6 +168,53 @@ def chain_speeds(
             reach += hop[i]
             i = int(model.parents[i])
     return rho
+
+
+def reach_ball(arm: ArmModel) -> tuple[NDArray[np.float64], float]:
+    """A ball that holds every body of ``arm`` at every state within its limits: its
+    centre ``(3,)`` and radius (metres). A point cloud keeps only the points whose balls
+    meet it, grown by the padding (``World.set_reach``, kcplan/_kernel/point_cloud.hpp):
+    no body ever meets the others, so every verdict stays that of the whole cloud.
+
+    The proof is the module docstring's: a point of body ``k`` lies within ``|c_k| +
+    a_max,k`` of its joint's origin, and each joint's origin within its placement's length
+    (plus a prismatic joint's largest slide) of its parent's. The walk stops at the joint
+    below the universe, whose origin before its own motion is fixed in the world: the
+    centre, when every moving body hangs from one such joint (a bodies' slide along that
+    joint counts); else the world's origin, the walk going on to it. A body that never
+    moves (joint 0) counts by its own centre."""
+    model = arm.model
+    state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
+    slide = np.zeros(model.njoints)  # a prismatic joint's largest slide
+    for i, j in state_of.items():
+        if arm.kinds[j] == "prismatic":
+            slide[i] = max(abs(arm.lower[j]), abs(arm.upper[j]))
+    length = [0.0] + [float(np.linalg.norm(model.jointPlacements[i].translation))
+                      for i in range(1, model.njoints)]  # fmt: skip
+
+    def root(i: int) -> int:
+        while int(model.parents[i]) > 0:
+            i = int(model.parents[i])
+        return i
+
+    roots = {root(b.joint) for b in arm.bodies if b.joint > 0}
+    fixed = roots.pop() if len(roots) == 1 else 0  # the centre's joint, or the universe
+    centre = np.zeros(3)
+    if fixed:
+        centre = np.asarray(model.jointPlacements[fixed].translation, dtype=float)
+    radius = 0.0
+    for b in arm.bodies:
+        i, reach = b.joint, float(np.linalg.norm(b.placement[:3, 3]) + b.semi_axes.max())
+        if i == 0:
+            reach = float(np.linalg.norm(b.placement[:3, 3] - centre) + b.semi_axes.max())
+        while i > 0:  # reach bounds |x - o_i|, o_i joint i's origin after its motion
+            if i == fixed:  # its origin before its motion: the centre
+                reach += slide[i]
+                break
+            reach += length[i] + slide[i]
+            i = int(model.parents[i])
+        radius = max(radius, reach)
+    return centre, radius
 
 
 def speeds(arm: ArmModel, q1: Sequence[float], q2: Sequence[float]) -> NDArray[np.float64]:

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from kcplan._kernel import build_kernel_arm
+from kcplan.arm.bounds import reach_ball
 from kcplan.arm.kinematics import body_frames
 from kcplan.arm.model import ArmModel
 from kcplan.arm.pairs import prove_pairs as prove_pairs_of
@@ -180,6 +181,13 @@ class ArmWorld:
     _nearest = property(lambda self: self._scene[2])
     _boxes = property(lambda self: self._scene[3])
     _manager = property(lambda self: self._scene[4])
+
+    @cached_property
+    def reach(self) -> tuple[NDArray[np.float64], float]:
+        """A ball (centre ``(3,)``, radius in metres) that holds every body at every state
+        (:func:`kcplan.arm.bounds.reach_ball`): :attr:`kernel`'s clouds keep the points
+        whose balls meet it grown by the padding, and no other."""
+        return reach_ball(self.arm)
 
     @property
     def kernel(self):
