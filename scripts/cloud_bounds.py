@@ -3,10 +3,9 @@ switched off.
 
 The kernel measures a link (or ellipsoid) against a cloud by walking its k-d tree and
 asking, for each node and point, bounds cheaper than GJK before GJK itself
-(``kcplan/_kernel/point_cloud.hpp``): a hull's 26 fixed planes, a hull's face planes for a
-point, the planes GJK's nearest points have shown, the support along the centres' line
-(an ellipsoid's or a ball's; a hull's was dropped, and the shape's own box, after this
-script measured them). Switched
+(``kcplan/_kernel/point_cloud.hpp``): a hull's 26 fixed planes, the planes GJK's nearest
+points have shown, the support along the centres' line (an ellipsoid's or a ball's; a
+hull's was dropped, and the shape's own box, after this script measured them). Switched
 off (``World.set_cloud_bounds``), the answers stay the same and only the work changes.
 For each scenario and each setting, ``--seeds`` plans (default planner, seeds 1..N in
 one fresh process per setting, so every setting sees the same sampling) report the median
@@ -35,8 +34,7 @@ SETTINGS = {
     "no 26 planes": {"dop": False},
     "no GJK planes": {"gjk_planes": False},
     "no centre line": {"centre_line": False},
-    "no face planes": {"faces": False},
-    "none": {"dop": False, "gjk_planes": False, "centre_line": False, "faces": False},
+    "none": {"dop": False, "gjk_planes": False, "centre_line": False},
 }
 
 

@@ -3,15 +3,13 @@ one process: what `perf record` samples in RESULTS 34.2 (run.sh). Prints the med
 whole call, the solve, the shortcuts and the rest (the world's build).
 
     python benchmarks/profile/plan_loop.py [--prims] [--seeds N] [--problems CLASS:I,...]
-        [--fresh [--forget]] [--no-reach] [--faces on|off]
+        [--fresh [--forget]] [--no-reach]
 
 ``--fresh`` reads each problem's scenario again before each plan, so that each plan has
 an arm of its own, as ``scripts/cloud_mbm.py``'s problems do; ``--forget`` then empties
 the kernel's chains and the pairs' proofs kept in memory before each plan, as each new
 arm found them before RESULTS 36.1 (the ablation of those caches). ``--no-reach`` keeps
 every point of a cloud, those beyond the arm's reach too (the ablation of RESULTS 36.2).
-``--faces on|off`` builds each plan's world before the clock, with a hull's face planes
-on or off (the ablation of RESULTS 36.3; "the rest" is then the setup alone).
 """
 
 import argparse
@@ -40,9 +38,6 @@ parser.add_argument("--prims", action="store_true", help="plan on the primitives
 parser.add_argument("--planner", default="kc-rrtconnect-lazy-native")
 parser.add_argument("--fresh", action="store_true", help="each plan on a scenario read anew")
 parser.add_argument("--forget", action="store_true", help="each plan without the arm caches")
-parser.add_argument("--faces", choices=("on", "off"),
-                    help="each plan on a world built before the clock, a hull's face planes on "
-                         "or off (the ablation of RESULTS 36.3)")  # fmt: skip
 parser.add_argument("--no-reach", action="store_true",
                     help="clouds keep the points beyond the arm's reach (the ablation)")
 args = parser.parse_args()
@@ -72,12 +67,8 @@ for key in keys:
         if args.forget:
             _kernel._CHAINS.clear()
             pairs._PROOFS.clear()
-        world = None
-        if args.faces:
-            world = ArmWorld(scenario.arm, scenario.obstacles, allowed=scenario.allowed)
-            world.kernel.scene.set_cloud_bounds(faces=args.faces == "on")
         t0 = time.perf_counter()
-        result = plan(scenario, args.planner, seed=seed, time_limit=10, world=world)
+        result = plan(scenario, args.planner, seed=seed, time_limit=10)
         rows.append((time.perf_counter() - t0, result.time, result.simplify_time))
 print(f"plans {len(rows)}: median ms whole {statistics.median(r[0] for r in rows) * 1e3:.1f}, "
       f"solve {statistics.median(r[1] for r in rows) * 1e3:.1f}, "

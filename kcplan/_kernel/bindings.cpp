@@ -61,7 +61,6 @@ nb::dict cloud_counters(const kcplan::World& w) {
   d["nodes"] = c.nodes;
   d["points"] = c.points;
   d["exact"] = c.exact;
-  d["faces"] = c.faces;
   return d;
 }
 
@@ -228,10 +227,10 @@ NB_MODULE(_core, m) {
       .def_prop_ro("cloud_counters", &cloud_counters)
       .def(
           "set_cloud_bounds",
-          [](kcplan::World& w, bool dop, bool gjk_planes, bool centre_line, bool faces) {
-            w.set_cloud_bounds(kcplan::CloudBounds{dop, gjk_planes, centre_line, faces});
+          [](kcplan::World& w, bool dop, bool gjk_planes, bool centre_line) {
+            w.set_cloud_bounds(kcplan::CloudBounds{dop, gjk_planes, centre_line});
           },
-          "dop"_a = true, "gjk_planes"_a = true, "centre_line"_a = true, "faces"_a = true,
+          "dop"_a = true, "gjk_planes"_a = true, "centre_line"_a = true,
           "Which cheaper bounds the clouds ask before GJK (point_cloud.hpp CloudBounds)")
       .def_prop_rw("cloud_tolerance", &kcplan::World::cloud_tolerance,
                    &kcplan::World::set_cloud_tolerance,

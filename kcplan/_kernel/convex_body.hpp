@@ -3,7 +3,6 @@
 // Python twin: kcplan/arm/hulls.py (BodyHull).
 #pragma once
 
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -30,33 +29,6 @@ class VertexSupport {
   Eigen::ArrayXd x_, y_, z_;
 };
 
-/// The planes of a convex polytope's faces, n . x <= offset for every point x of it: one
-/// per distinct triangle normal (unit n, turned outwards), its offset the support over
-/// every vertex rounded up, so that each plane holds the polytope whatever a triangle's
-/// orientation or rounding. For a point p, max over the planes of n . p - offset is a
-/// lower bound of p's distance to the polytope (every x of it has |p - x| >= n . (p - x)),
-/// and is that distance when p's nearest point lies inside a face.
-class FacePlanes {
- public:
-  FacePlanes(const std::vector<coal::Vec3s>& points,
-             const std::vector<coal::Triangle>& triangles, const VertexSupport& support);
-  /// The largest n . p - offset over the planes (< 0: p inside; -inf for no plane).
-  double lower_bound(const coal::Vec3s& p) const {
-    if (offset_.size() == 0) return -std::numeric_limits<double>::infinity();
-    return (x_ * p[0] + y_ * p[1] + z_ * p[2] - offset_).maxCoeff();
-  }
-  std::size_t size() const { return static_cast<std::size_t>(offset_.size()); }
-  /// p's distance to the polytope when a face's plane gives it, and that face's normal:
-  /// 0 when p lies inside; else the largest n . p - offset, b, when p - b n (p's foot on
-  /// that plane) lies within every plane, to a rounding allowance. The answer is a lower
-  /// bound of the distance either way, and within the allowance (1e-12 of the numbers)
-  /// of it. false when the foot lies outside (p is nearest an edge or a corner: GJK's).
-  bool face_distance(const coal::Vec3s& p, double& distance, coal::Vec3s& normal) const;
-
- private:
-  Eigen::ArrayXd x_, y_, z_, offset_;
-};
-
 /// coal's Convex with its vertices' VertexSupport: what make_convex builds. It marks
 /// itself in CollisionGeometry::user_data (pointing to itself), so that a support query
 /// given only the coal geometry can tell it from any other ConvexBase (a copy made by
@@ -71,16 +43,9 @@ class SupportedConvex : public coal::Convex<coal::Triangle> {
                ? &static_cast<const SupportedConvex&>(geometry).support_
                : nullptr;
   }
-  /// The FacePlanes of `geometry` if it is a SupportedConvex, else null.
-  static const FacePlanes* faces_of(const coal::CollisionGeometry& geometry) {
-    return geometry.user_data == &geometry
-               ? &static_cast<const SupportedConvex&>(geometry).faces_
-               : nullptr;
-  }
 
  private:
   VertexSupport support_;
-  FacePlanes faces_;
 };
 
 /// A convex polytope from m x 3 vertices and t x 3 triangle indices (flat): a

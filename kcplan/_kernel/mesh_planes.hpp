@@ -33,7 +33,6 @@ struct ShapeSupport {
   bool capsule = false;
   const std::vector<coal::Vec3s>* hull = nullptr;  // polytope: its vertices v
   const VertexSupport* hull_support = nullptr;       // and their support, if it has one
-  const FacePlanes* hull_faces = nullptr;            // and their faces' planes, likewise
   coal::Matrix3s rotation = coal::Matrix3s::Identity();  // polytope: R
   double spread_low = 0.0, spread_high = 0.0;
 
@@ -45,7 +44,6 @@ struct ShapeSupport {
     out.capsule = false;
     out.hull = nullptr;
     out.hull_support = nullptr;
-    out.hull_faces = nullptr;
     // by coal's node type, not dynamic_cast: this runs for every broad-phase candidate,
     // and a failed cross-library dynamic_cast compares type names
     switch (g == nullptr ? coal::BV_UNKNOWN : g->getNodeType()) {
@@ -75,7 +73,6 @@ struct ShapeSupport {
         // |h(n) - n . c| <= that bound whatever the frame's origin is
         out.hull = h->points.get();
         out.hull_support = SupportedConvex::of(*h);
-        out.hull_faces = SupportedConvex::faces_of(*h);
         out.rotation = tf.getRotation();
         out.spread_high = (h->aabb_center.norm() + h->aabb_radius) * (1.0 + 1e-12);
         out.spread_low = -out.spread_high;

@@ -105,7 +105,6 @@ struct PointCloud::Query {
   coal::Matrix3s rotation;  // the shape's frame
   Vec3s origin;
   const Dop* dop = nullptr;  // a hull's supports along kDopDirections (its frame), or null
-  const FacePlanes* faces = nullptr;  // a hull's face planes (its frame), or null
   // those planes in the world, a coordinate to an array (26 products at once): the
   // normals n, their absolute values |n| (a box's half sides' reach) and the offsets
   using Planes = Eigen::Array<double, 26, 1>;
@@ -118,7 +117,6 @@ struct PointCloud::Query {
         use(cloud.bounds_used) {
     rotation = o.getTransform().getRotation();
     origin = o.getTransform().getTranslation();
-    if (use.faces) faces = support.hull_faces;
     if (support.hull_support != nullptr && use.dop) {
       dop = &cloud.dop_of(*o.collisionGeometryPtr(), *support.hull_support);
       // the planes in the world: d . x <= h_d + d . t for the world's d = R d_local
@@ -133,23 +131,6 @@ struct PointCloud::Query {
     scale = 1.0 + support.centre.norm() + std::abs(support.spread_high);
     ball = supported && support.hull == nullptr && !support.capsule &&
            support.spread_low == support.spread_high;
-  }
-
-  /// The distance from the hull to the ball of `radius` about `p` when a face plane
-  /// gives it (FacePlanes::face_distance, less the radius, 0 on contact), and `towards`,
-  /// the unit direction from the ball to the hull; that plane is kept (add_plane).
-  bool face_distance(const Vec3s& p, double radius, double& d, Vec3s& towards) {
-    Vec3s n;
-    if (!faces->face_distance(rotation.transpose() * (p - origin), d, n)) return false;
-    d = std::max(d - radius, 0.0);
-    if (d > 0.0) {  // the face's outward normal, in the world: from the hull to the ball
-      const Vec3s out = rotation * n;
-      add_plane(out);
-      towards = -out;
-    } else {
-      towards.setZero();
-    }
-    return true;
   }
 
   /// Keep the plane across unit `n` that touches the shape (its support there).
@@ -191,11 +172,6 @@ struct PointCloud::Query {
       lower = std::max(lower, normals[j].dot(m) - (Point ? 0.0 : normals[j].cwiseAbs().dot(half)) -
                                   offsets[j]);
     if (lower - slack >= best) return lower - slack;
-    if (Point && faces != nullptr) {  // a point against the hull's faces, in its frame
-      const Vec3s local = rotation.transpose() * (m - origin);
-      lower = std::max(lower, faces->lower_bound(local));
-      if (lower - slack >= best) return lower - slack;
-    }
     // a polytope's support is a scan of its vertices: it cost more than it saved
     // (scripts/cloud_bounds.py), so hulls go to GJK here; an ellipsoid's is one product
     if (length > 0.0 && use.centre_line && support.hull == nullptr)
@@ -362,8 +338,6 @@ double PointCloud::search(Query& q, double cap, double stop_below, const Distanc
           dir = q.support.centre - points_[i];
           const double length = dir.norm();
           dir = length > 0.0 ? Vec3s(dir / length) : Vec3s(Vec3s::Zero());
-        } else if (q.faces != nullptr && q.face_distance(points_[i], radius_, d, dir)) {
-          ++counters.faces;
         } else {
           d = exact(q, i, dir);
         }

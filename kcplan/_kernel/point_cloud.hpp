@@ -26,7 +26,6 @@ struct CloudCounters {
   std::int64_t nodes = 0;    ///< tree nodes whose bound was computed
   std::int64_t points = 0;   ///< points whose own bound was computed
   std::int64_t exact = 0;    ///< points measured by coal's GJK (their bound did not decide)
-  std::int64_t faces = 0;    ///< points measured by a hull's face planes (no GJK)
 };
 
 /// Which of a cloud's cheaper bounds are asked before GJK (all by default; switched off
@@ -35,7 +34,6 @@ struct CloudBounds {
   bool dop = true;          ///< a hull's 26 fixed planes
   bool gjk_planes = true;   ///< the planes GJK's nearest points have shown in this query
   bool centre_line = true;  ///< the support along the centres' line (not for hulls)
-  bool faces = true;        ///< a hull's face planes, for a point the 26 planes leave open
 };
 
 /// How far below the distance to a cloud its answer may lie: a search that stops early.
@@ -103,10 +101,6 @@ enum class CloudOrder {
 ///  - for a convex polytope (a link's hull), the 26 planes across the faces, edges and
 ///    corners of its frame's cube that touch it (its support there, found once per hull):
 ///    the largest d . (m - c) - h(d) - rho, in the hull's frame;
-///  - for a point p and a convex polytope, the planes of its faces (FacePlanes, in the
-///    hull's frame): every x of the hull has |p - x| >= n_f . (p - x) >= n_f . p - h(n_f).
-///    The largest is the distance itself when p's nearest point of the hull lies inside a
-///    face, so most points the 26 planes leave open are decided without GJK;
 ///  - the planes {x : n . x <= h_S(n)} that hold S, one for each direction GJK's nearest
 ///    points have given so far in this query (a point of the cloud measured exactly):
 ///    every y of B has n . y >= n . m - |n| . half, so |y - x| >= n . m - |n| . half -
@@ -115,8 +109,7 @@ enum class CloudOrder {
 ///
 /// A point p is bounded the same way (rho = 0), and the bound along the centres' line is
 /// the distance itself when S is a ball (then taken as it is, less its rounding
-/// allowance: no GJK). Against a hull, a point whose foot on its nearest face plane lies
-/// in the hull is measured by that plane (FacePlanes::face_distance: no GJK either). A point whose bound cannot decide the query is measured by coal's
+/// allowance: no GJK). A point whose bound cannot decide the query is measured by coal's
 /// GJK (a sphere of the cloud's radius about p against S), exactly as any other obstacle
 /// is: the distance the cloud returns is then coal's distance to the nearest ball, or a
 /// lower bound proven to be at least the cap asked for. Its error is therefore coal's
@@ -180,7 +173,6 @@ class PointCloud {
   using Dop = std::array<double, 26>;
   /// The Dop of a link's hull (an immutable SupportedConvex), made on its first query.
   const Dop& dop_of(const coal::CollisionGeometry& hull, const VertexSupport& support);
-
 
   /// Fill node `index` (already allocated) with points_[begin, end) and its subtree, the
   /// points split at the median of the box's longest side (CloudOrder::median).

@@ -431,7 +431,6 @@ CloudCounters World::cloud_counters() const {
       sum.nodes += cloud->counters.nodes;
       sum.points += cloud->counters.points;
       sum.exact += cloud->counters.exact;
-      sum.faces += cloud->counters.faces;
     }
   return sum;
 }
