@@ -7,6 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import trimesh
+from conftest import _examples_installed
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -445,3 +446,38 @@ def test_link_covers_are_cut_until_they_stick_out_at_most_max_offset(tmp_path, m
     )
     with pytest.raises(ScenarioError, match=r"robot\.max_offset: expected a positive number"):
         load_scenario(scenario)
+
+
+def _reach_arms():
+    from kcplan.scenarios import load_scenario
+
+    yield "panda", load_scenario(ROOT / "scenarios/arm/box_1.yaml").arm
+    yield "ur5", load_arm(UR5 / "ur5.urdf", UR5_GROUP)
+    yield "panda-ellipsoids", load_arm(PANDA / "panda.urdf", GROUP, bodies_per_link=2)
+    if _examples_installed():  # a base that drives (prismatic), two arms on one torso
+        for name in ("example_pr2_doorway", "example_baxter"):
+            yield name, load_scenario(ROOT / f"scenarios/arm/{name}.yaml").arm
+
+
+def test_the_reach_ball_holds_every_body_at_every_state():
+    """RESULTS 36.2 and 36.5: a cloud keeps only the points within this ball, so every
+    point of every body must lie in it, at random states and at the joint box's corners
+    (where the chain stretches)."""
+    from kcplan.arm.bounds import reach_ball
+
+    rng = np.random.default_rng(0)
+    for name, arm in _reach_arms():
+        centre, radius = reach_ball(arm)
+        states = rng.uniform(arm.lower, arm.upper, size=(150, arm.dof))
+        corners = np.where(rng.random((50, arm.dof)) < 0.5, arm.lower, arm.upper)
+        farthest = 0.0
+        for q in np.vstack([states, corners]):
+            for body, frame in zip(arm.bodies, body_frames(arm, q), strict=True):
+                if body.hull is not None:
+                    points = body.hull.vertices @ frame[:3, :3].T + frame[:3, 3]
+                    far = np.linalg.norm(points - centre, axis=1).max()
+                else:
+                    far = np.linalg.norm(frame[:3, 3] - centre) + body.semi_axes.max()
+                farthest = max(farthest, far)
+        assert farthest <= radius, (name, farthest, radius)
+        assert farthest > 0.5 * radius, (name, farthest, radius)  # a bound worth having

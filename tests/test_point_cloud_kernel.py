@@ -315,6 +315,8 @@ def test_a_reach_is_set_before_the_obstacles_and_a_cloud_beyond_it_is_no_obstacl
     assert world.n_objects == 0 and world.cloud_points == 0
     world.add_points(np.array([[0.5, 0.0, 0.0], [0.0, 4.0, 0.0]]), 0.01)
     assert world.n_objects == 1 and world.cloud_points == 1
+    with pytest.raises(ValueError, match="expected finite coordinates"):
+        world.add_points(np.array([[3.0, 0.0, 0.0], [np.nan, 0.0, 0.0]]), 0.01)
     with pytest.raises(ValueError, match="reach: expected before the first obstacle"):
         world.set_reach([0.0, 0.0, 0.0], 2.0)
     with pytest.raises(ValueError, match="reach: expected a finite centre and a radius > 0"):

@@ -388,9 +388,11 @@ void World::add_mesh(const std::vector<double>& vertices, const std::vector<int>
 void World::add_points(const double* xyz, std::size_t n, double radius, CloudOrder order) {
   if (dimension_ != 3) throw std::invalid_argument("point cloud: a 3D obstacle");
   if (n > 0 && std::isfinite(reach_.radius)) {  // no obstacle when nothing is within reach
-    bool any = false;
-    for (std::size_t i = 0; i < n && !any; ++i)
-      any = PointCloud::reachable(Eigen::Map<const Vec3s>(xyz + 3 * i), radius, reach_);
+    bool any = false;  // a point within reach, or one the cloud refuses (not finite)
+    for (std::size_t i = 0; i < n && !any; ++i) {
+      const Eigen::Map<const Vec3s> p(xyz + 3 * i);
+      any = !p.allFinite() || PointCloud::reachable(p, radius, reach_);
+    }
     if (!any && std::isfinite(radius) && radius > 0.0) return;
   }
   auto cloud = std::make_unique<PointCloud>(xyz, n, radius, order, 8, reach_);

@@ -87,6 +87,7 @@ These are the bounds of the clearance-ball certificate for arms: a body whose cl
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -170,50 +171,111 @@ def chain_speeds(
     return rho
 
 
+def _radial(p: NDArray, u: NDArray, c: float, sine: float, rho: float) -> float:
+    """The largest distance from a parent joint's axis ``a`` of the disk ``x + w`` (``w``
+    normal to a child's axis ``d``, ``|w| <= rho``) about a point ``x`` whose part normal
+    to ``a`` is ``p``; ``u = d - c a`` (``c = a . d``, ``|u| = sine``). In the plane
+    normal to ``a`` the disk projects to an ellipse of half axes ``rho`` (along ``a x d``)
+    and ``rho |c|`` (along ``u``); with ``p = p_1 (a x d)^ + p_u u^``, Cauchy-Schwarz gives
+    ``|p + w|^2 <= |p|^2 + 2 rho sqrt(p_1^2 + c^2 p_u^2) + rho^2``."""
+    square = float(p @ p)
+    along = float(p @ u) / sine if sine > 1e-12 else 0.0
+    across = max(square - along * along, 0.0)
+    return math.sqrt(square + 2.0 * rho * math.sqrt(across + c * c * along * along) + rho * rho)
+
+
 def reach_ball(arm: ArmModel) -> tuple[NDArray[np.float64], float]:
     """A ball that holds every body of ``arm`` at every state within its limits: its
     centre ``(3,)`` and radius (metres). A point cloud keeps only the points whose balls
     meet it, grown by the padding (``World.set_reach``, kcplan/_kernel/point_cloud.hpp):
     no body ever meets the others, so every verdict stays that of the whole cloud.
 
-    The proof is the module docstring's: a point of body ``k`` lies within ``|c_k| +
-    a_max,k`` of its joint's origin, and each joint's origin within its placement's length
-    (plus a prismatic joint's largest slide) of its parent's. The walk stops at the joint
-    below the universe, whose origin before its own motion is fixed in the world: the
-    centre, when every moving body hangs from one such joint (a bodies' slide along that
-    joint counts); else the world's origin, the walk going on to it. A body that never
-    moves (joint 0) counts by its own centre."""
+    The proof bounds, from the leaves up, all that joint ``i`` carries over the whole
+    joint box, in its frame before its own motion: by a ball of radius ``B`` about its
+    origin, and by a cylinder about its axis ``a`` (an axial interval ``[lo, hi]`` and a
+    radius ``rho``: a point ``z a + w``, ``w`` normal to ``a``, has ``z`` in the interval
+    and ``|w| <= rho``). Turning about ``a`` moves no point out of either; a slide along
+    ``a`` widens the interval by its limits and ``B`` by its largest. A body gives its own
+    extents (a hull's vertices; an ellipsoid's centre and largest semi-axis). A child's
+    points ``t + z d + w`` (its placement ``t``, its axis ``d`` in the parent's frame, ``c
+    = a . d``) lie
+      - axially within ``a . t + z c`` plus at most ``rho sqrt(1 - c^2)``,
+      - radially within :func:`_radial` of ``t + z d`` (convex in ``z``: largest at an
+        end),
+      - within ``|t| + B`` of the parent's origin (the triangle inequality, as
+        ``point_speeds`` adds the placements' lengths), and within ``sqrt(|t + z d|^2 + 2
+        rho |t - (t . d) d| + rho^2)`` (``d . w = 0``), whichever is smaller;
+    and the cylinder is cut to the ball (``rho <= B``, ``|z| <= B``). The first joint below
+    the universe keeps its origin however the joints turn: when every moving body hangs
+    from it, that origin is the centre and the radius the smaller of ``B`` and
+    ``sqrt(max(lo^2, hi^2) + rho^2)``; else the centre is the world's origin and each such
+    joint adds its placement's length. A body that never moves (joint 0) counts by its
+    own distance from the centre (RESULTS 36.5)."""
     model = arm.model
+    axes = arm.joint_axes()
     state_of = {int(model.getJointId(name)): j for j, name in enumerate(arm.joints)}
-    slide = np.zeros(model.njoints)  # a prismatic joint's largest slide
-    for i, j in state_of.items():
-        if arm.kinds[j] == "prismatic":
-            slide[i] = max(abs(arm.lower[j]), abs(arm.upper[j]))
-    length = [0.0] + [float(np.linalg.norm(model.jointPlacements[i].translation))
-                      for i in range(1, model.njoints)]  # fmt: skip
+    n = model.njoints
+    lo, hi, rho, ball = np.full(n, np.inf), np.full(n, -np.inf), np.zeros(n), np.zeros(n)
 
-    def root(i: int) -> int:
-        while int(model.parents[i]) > 0:
-            i = int(model.parents[i])
-        return i
+    def include(i: int, z_lo: float, z_hi: float, r: float, b: float) -> None:
+        lo[i], hi[i] = min(lo[i], z_lo), max(hi[i], z_hi)
+        rho[i], ball[i] = max(rho[i], r), max(ball[i], b)
 
-    roots = {root(b.joint) for b in arm.bodies if b.joint > 0}
-    fixed = roots.pop() if len(roots) == 1 else 0  # the centre's joint, or the universe
-    centre = np.zeros(3)
-    if fixed:
-        centre = np.asarray(model.jointPlacements[fixed].translation, dtype=float)
-    radius = 0.0
     for b in arm.bodies:
-        i, reach = b.joint, float(np.linalg.norm(b.placement[:3, 3]) + b.semi_axes.max())
-        if i == 0:
-            reach = float(np.linalg.norm(b.placement[:3, 3] - centre) + b.semi_axes.max())
-        while i > 0:  # reach bounds |x - o_i|, o_i joint i's origin after its motion
-            if i == fixed:  # its origin before its motion: the centre
-                reach += slide[i]
-                break
-            reach += length[i] + slide[i]
-            i = int(model.parents[i])
-        radius = max(radius, reach)
+        if b.joint == 0:
+            continue
+        a = axes[b.joint]
+        if b.hull is not None:  # the vertices in the joint's frame
+            v = b.hull.vertices @ b.placement[:3, :3].T + b.placement[:3, 3]
+            z = v @ a
+            radial = float(np.linalg.norm(v - np.outer(z, a), axis=1).max())
+            include(b.joint, z.min(), z.max(), radial, float(np.linalg.norm(v, axis=1).max()))
+        else:
+            c, r = b.placement[:3, 3], float(b.semi_axes.max())
+            include(b.joint, c @ a - r, c @ a + r, float(np.linalg.norm(c - (c @ a) * a)) + r,
+                    float(np.linalg.norm(c)) + r)  # fmt: skip
+    roots = []
+    for i in range(n - 1, 0, -1):  # children before parents
+        if not np.isfinite(lo[i]):
+            continue  # carries nothing
+        j = state_of.get(i)
+        if j is not None and arm.kinds[j] == "prismatic":  # a slide of lower..upper
+            lo[i], hi[i] = lo[i] + arm.lower[j], hi[i] + arm.upper[j]
+            ball[i] += max(abs(arm.lower[j]), abs(arm.upper[j]))
+        lo[i], hi[i], rho[i] = max(lo[i], -ball[i]), min(hi[i], ball[i]), min(rho[i], ball[i])
+        parent = int(model.parents[i])
+        if parent == 0:
+            roots.append(i)
+            continue
+        placement = model.jointPlacements[i]
+        t, d = np.asarray(placement.translation, dtype=float), placement.rotation @ axes[i]
+        a = axes[parent]
+        c = float(np.clip(a @ d, -1.0, 1.0))
+        sine = math.sqrt(max(1.0 - c * c, 0.0))
+        ends = [t + lo[i] * d, t + hi[i] * d]
+        axial = [float(a @ e) for e in ends]
+        across = float(np.linalg.norm(t - (t @ d) * d))
+        far = max(math.sqrt(float(e @ e) + 2.0 * rho[i] * across + rho[i] ** 2) for e in ends)
+        include(parent, min(axial) - rho[i] * sine, max(axial) + rho[i] * sine,
+                max(_radial(e - (a @ e) * a, d - c * a, c, sine, rho[i]) for e in ends),
+                min(float(np.linalg.norm(t)) + ball[i], far))  # fmt: skip
+    reach = {k: min(ball[k], math.hypot(max(abs(lo[k]), abs(hi[k])), rho[k])) for k in roots}
+    grow = 1.0 + 1e-9  # rounding: a few products of the numbers, each within 1e-15 of them
+    if len(roots) == 1:
+        centre = np.asarray(model.jointPlacements[roots[0]].translation, dtype=float)
+        radius = reach[roots[0]] * grow
+    else:
+        centre = np.zeros(3)
+        radius = max((float(np.linalg.norm(model.jointPlacements[k].translation)) + reach[k])
+                     * grow for k in roots) if roots else 0.0  # fmt: skip
+    for b in arm.bodies:  # the bodies that never move, by their own place
+        if b.joint == 0:
+            if b.hull is not None:
+                v = b.hull.vertices @ b.placement[:3, :3].T + b.placement[:3, 3]
+                far = float(np.linalg.norm(v - centre, axis=1).max())
+            else:
+                far = float(np.linalg.norm(b.placement[:3, 3] - centre) + b.semi_axes.max())
+            radius = max(radius, far * grow)
     return centre, radius
 
 
