@@ -224,8 +224,8 @@ def arm_digest(arm) -> str:
     other: its chain (:func:`kernel_chain`) and its self pairs' proofs
     (:mod:`kcplan.arm.pairs`). A scenario read again (each MotionBenchMaker problem is
     its own scenario) loads a new arm of the same robot, and the chain and the proofs
-    cost 3.5 ms of its first plan (RESULTS 36.1). Computed once per arm object (0.5 ms
-    for the Panda)."""
+    cost 2 ms of its first plan (RESULTS 36.1). Computed once per arm object (0.5 ms for
+    the Panda)."""
     digest = _DIGESTS.get(arm)
     if digest is None:
         model = arm.model
