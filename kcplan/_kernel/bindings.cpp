@@ -165,7 +165,6 @@ NB_MODULE(_core, m) {
       .def("set_reach", &kcplan::World::set_reach, "centre"_a, "radius"_a,
            "A ball (metres) that holds every body at every state, padding included: the "
            "clouds added after it keep only the points whose balls meet it")
-      .def_prop_ro("reach_radius", [](const kcplan::World& w) { return w.reach().radius; })
       .def_prop_ro("cloud_points", [](const kcplan::World& w) { return w.cloud_points(); },
                    "Points every cloud kept (those within reach)")
       .def("finalize", &kcplan::World::finalize)

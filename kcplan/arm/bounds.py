@@ -184,6 +184,11 @@ def _radial(p: NDArray, u: NDArray, c: float, sine: float, rho: float) -> float:
     return math.sqrt(square + 2.0 * rho * math.sqrt(across + c * c * along * along) + rho * rho)
 
 
+def _joint_frame_vertices(body) -> NDArray[np.float64]:
+    """A hull body's vertices in its joint's frame (the world's for joint 0), ``(m, 3)``."""
+    return body.hull.vertices @ body.placement[:3, :3].T + body.placement[:3, 3]
+
+
 def reach_ball(arm: ArmModel) -> tuple[NDArray[np.float64], float]:
     """A ball that holds every body of ``arm`` at every state within its limits: its
     centre ``(3,)`` and radius (metres). A point cloud keeps only the points whose balls
@@ -225,8 +230,8 @@ def reach_ball(arm: ArmModel) -> tuple[NDArray[np.float64], float]:
         if b.joint == 0:
             continue
         a = axes[b.joint]
-        if b.hull is not None:  # the vertices in the joint's frame
-            v = b.hull.vertices @ b.placement[:3, :3].T + b.placement[:3, 3]
+        if b.hull is not None:
+            v = _joint_frame_vertices(b)
             z = v @ a
             radial = float(np.linalg.norm(v - np.outer(z, a), axis=1).max())
             include(b.joint, z.min(), z.max(), radial, float(np.linalg.norm(v, axis=1).max()))
@@ -271,8 +276,7 @@ def reach_ball(arm: ArmModel) -> tuple[NDArray[np.float64], float]:
     for b in arm.bodies:  # the bodies that never move, by their own place
         if b.joint == 0:
             if b.hull is not None:
-                v = b.hull.vertices @ b.placement[:3, :3].T + b.placement[:3, 3]
-                far = float(np.linalg.norm(v - centre, axis=1).max())
+                far = float(np.linalg.norm(_joint_frame_vertices(b) - centre, axis=1).max())
             else:
                 far = float(np.linalg.norm(b.placement[:3, 3] - centre) + b.semi_axes.max())
             radius = max(radius, far * grow)
